@@ -1,0 +1,474 @@
+# libodhs - GNU Makefile (plain GNU make, no autotools/cmake).
+#
+# Main targets (`make help` prints this list):
+#   all (default)   lib/libodhs.a, lib/libodhs.so.X.Y.Z + soname/dev symlinks
+#   check           build and run the Check test runner, plus check-symbols
+#   check-asan      rebuild library + tests in build-asan/ with ASan/UBSan, run
+#   check-symbols   fail if lib/libodhs.so exports anything not named odhs_*
+#   check-run       run the tests without deps-if-missing/check-symbols
+#   tests           only build the runner build/tests/run_tests
+#   examples        stage-install into build/stage, build examples/*.c against
+#                   it with pkg-config only, run pkgconfig-test
+#   pkgconfig-test  compile + run tests/pkgconfig_consumer.c, shared and static
+#   stage           `make install` into build/stage (used by examples)
+#   demo            deps-if-missing, all, examples, run build/examples/shear_flow
+#   bench           build bench/*.c against lib/libodhs.a into build/bench/
+#   install, uninstall   honour PREFIX, DESTDIR, LIBDIR, INCLUDEDIR
+#   deps, deps-if-missing   install the Debian build dependencies (apt-get)
+#   clean           remove build/, build-asan/, lib/*.a, lib/*.so*
+#
+# Knobs (set on the command line, e.g. `make SUITESPARSE=0 check`):
+#   SUITESPARSE=auto|1|0   CHOLMOD/SPQR backends (auto: if cholmod.h exists)
+#   OPTFLAGS=-O2 -g        optimisation/debug flags
+#   WARNFLAGS=...          warnings (default includes -Werror)
+#   CC, CFLAGS, CPPFLAGS, LDFLAGS, LDLIBS   appended as usual
+#   PREFIX, LIBDIR, INCLUDEDIR, DESTDIR     install locations
+
+# Disable the built-in implicit rules and variables: every rule is below.
+MAKEFLAGS += --no-builtin-rules
+.SUFFIXES:
+# Delete a target whose recipe failed half-way (no truncated .o or .a left).
+.DELETE_ON_ERROR:
+
+.DEFAULT_GOAL := all
+
+# ---------------------------------------------------------------------------
+# Version: parsed from the public header, the single source of truth.
+# ---------------------------------------------------------------------------
+VERSION_HEADER := include/odhs/common.h
+odhs_version_field = $(shell sed -n \
+    's/^[[:space:]]*\#[[:space:]]*define[[:space:]]\{1,\}ODHS_VERSION_$(1)[[:space:]]\{1,\}\([0-9]\{1,\}\).*/\1/p' \
+    $(VERSION_HEADER))
+MAJOR := $(call odhs_version_field,MAJOR)
+MINOR := $(call odhs_version_field,MINOR)
+PATCH := $(call odhs_version_field,PATCH)
+ifeq ($(strip $(MAJOR)),)
+$(error could not parse ODHS_VERSION_MAJOR from $(VERSION_HEADER))
+endif
+ifeq ($(strip $(MINOR)),)
+$(error could not parse ODHS_VERSION_MINOR from $(VERSION_HEADER))
+endif
+ifeq ($(strip $(PATCH)),)
+$(error could not parse ODHS_VERSION_PATCH from $(VERSION_HEADER))
+endif
+VERSION := $(MAJOR).$(MINOR).$(PATCH)
+
+# ---------------------------------------------------------------------------
+# Tools and install locations
+# ---------------------------------------------------------------------------
+CC         ?= cc
+AR         ?= ar
+PKG_CONFIG ?= pkg-config
+INSTALL    ?= install
+
+PREFIX     ?= /usr/local
+LIBDIR     ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+DESTDIR    ?=
+
+# ---------------------------------------------------------------------------
+# Build directories. BUILD and OUT_LIBDIR are overridden by check-asan so that
+# the sanitizer build lives entirely in build-asan/ and never touches build/
+# or lib/.
+# ---------------------------------------------------------------------------
+BUILD      ?= build
+OUT_LIBDIR ?= lib
+OBJDIR     := $(BUILD)/obj
+
+# ---------------------------------------------------------------------------
+# Optional SuiteSparse (CHOLMOD + SPQR). Debian's SuiteSparse 5.x has no .pc
+# files, so the header directory and library names are given by hand.
+# ---------------------------------------------------------------------------
+SUITESPARSE     ?= auto
+SUITESPARSE_INC ?= /usr/include/suitesparse
+SUITESPARSE_LIBS_LIST := -lspqr -lcholmod -lsuitesparseconfig
+
+ifeq ($(SUITESPARSE),auto)
+  HAVE_SUITESPARSE := $(if $(wildcard $(SUITESPARSE_INC)/cholmod.h),1,0)
+else ifneq ($(filter 1 yes on true,$(SUITESPARSE)),)
+  HAVE_SUITESPARSE := 1
+else ifneq ($(filter 0 no off false,$(SUITESPARSE)),)
+  HAVE_SUITESPARSE := 0
+else
+  $(error SUITESPARSE must be auto, 1 or 0 (got '$(SUITESPARSE)'))
+endif
+
+ifeq ($(HAVE_SUITESPARSE),1)
+  SUITESPARSE_CPPFLAGS := -I$(SUITESPARSE_INC) -DODHS_HAVE_SUITESPARSE=1
+  SUITESPARSE_LIBS     := $(SUITESPARSE_LIBS_LIST)
+else
+  SUITESPARSE_CPPFLAGS :=
+  SUITESPARSE_LIBS     :=
+endif
+
+# LAPACKE/LAPACK/BLAS are always required.
+MATH_LIBS := -llapacke -llapack -lblas -lm
+
+# Everything the library itself links against (also Libs.private in odhs.pc).
+ODHS_LIBS    := $(SUITESPARSE_LIBS) $(MATH_LIBS)
+LIBS_PRIVATE := $(strip $(ODHS_LIBS))
+
+# ---------------------------------------------------------------------------
+# Compiler flags. ODHS_* are the fixed project flags; CFLAGS/CPPFLAGS/LDFLAGS
+# stay free for the user and are appended last.
+# ---------------------------------------------------------------------------
+OPTFLAGS  ?= -O2 -g
+WARNFLAGS ?= -Wall -Wextra -Wpedantic -Werror
+SANFLAGS  ?=
+DEPFLAGS  := -MMD -MP
+
+ODHS_CPPFLAGS := -Iinclude -Ilib $(SUITESPARSE_CPPFLAGS) -DODHS_HAVE_LAPACKE=1
+ODHS_CFLAGS   := -std=c11 $(OPTFLAGS) $(WARNFLAGS) $(SANFLAGS) -fPIC -fvisibility=hidden
+
+LIB_COMPILE = $(CC) $(ODHS_CPPFLAGS) $(CPPFLAGS) $(ODHS_CFLAGS) $(CFLAGS) $(DEPFLAGS)
+
+# Check's flags are looked up lazily (only when a test target needs them) and
+# then cached, so `make clean` or `make deps` work on a bare machine.
+CHECK_CFLAGS = $(eval CHECK_CFLAGS := $(shell $(PKG_CONFIG) --cflags check))$(CHECK_CFLAGS)
+CHECK_LIBS   = $(eval CHECK_LIBS := $(shell $(PKG_CONFIG) --libs check))$(CHECK_LIBS)
+
+# ---------------------------------------------------------------------------
+# Library sources and products (wildcards: new files are picked up).
+# ---------------------------------------------------------------------------
+LIB_SRCS := $(sort $(wildcard lib/*.c lib/solvers/*.c))
+LIB_OBJS := $(LIB_SRCS:%.c=$(OBJDIR)/%.o)
+
+STATIC_LIB     := $(OUT_LIBDIR)/libodhs.a
+SONAME         := libodhs.so.$(MAJOR)
+SHARED_REAL    := $(OUT_LIBDIR)/libodhs.so.$(VERSION)
+SHARED_SONAME  := $(OUT_LIBDIR)/$(SONAME)
+SHARED_DEVLINK := $(OUT_LIBDIR)/libodhs.so
+
+PUBLIC_HEADERS := include/odhs.h $(sort $(wildcard include/odhs/*.h))
+
+# ---------------------------------------------------------------------------
+# Tests: one tests/check_<module>.c per module defining
+# `Suite *make_<module>_suite(void);`, one runner tests/check_main.c.
+# Every other tests/*.c (e.g. a future tests/testutil.c) is linked into the
+# runner too, except the stand-alone pkg-config consumer.
+# ---------------------------------------------------------------------------
+TEST_RUNNER_MAIN := tests/check_main.c
+TEST_STANDALONE  := tests/pkgconfig_consumer.c
+TEST_SUITE_SRCS  := $(sort $(filter-out $(TEST_RUNNER_MAIN),$(wildcard tests/check_*.c)))
+TEST_MODULES     := $(patsubst tests/check_%.c,%,$(TEST_SUITE_SRCS))
+TEST_SRCS        := $(sort $(filter-out $(TEST_STANDALONE),$(wildcard tests/*.c)))
+TEST_OBJS        := $(TEST_SRCS:%.c=$(OBJDIR)/%.o)
+SUITES_INC       := $(BUILD)/tests/suites.inc
+TEST_RUNNER      := $(BUILD)/tests/run_tests
+
+TEST_COMPILE = $(CC) -I$(BUILD)/tests -Itests $(ODHS_CPPFLAGS) $(CPPFLAGS) \
+               $(CHECK_CFLAGS) $(ODHS_CFLAGS) $(CFLAGS) $(DEPFLAGS)
+
+# Environment for running the tests. Check reads CK_RUN_SUITE, CK_RUN_CASE,
+# CK_FORK, CK_VERBOSITY, CK_DEFAULT_TIMEOUT itself. OpenBLAS is kept
+# single-threaded: the test matrices are small, and a threaded OpenBLAS pool
+# plus Check's fork-per-test is a known source of hangs.
+TEST_ENV ?= CK_DEFAULT_TIMEOUT=600 OPENBLAS_NUM_THREADS=1
+
+# Sanitizer configuration for check-asan.
+ASAN_BUILD    := build-asan
+ASAN_SANFLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+ASAN_TEST_ENV := CK_FORK=no CK_DEFAULT_TIMEOUT=600 OPENBLAS_NUM_THREADS=1 \
+                 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
+
+# ---------------------------------------------------------------------------
+# Examples, pkg-config consumer, benchmarks
+# ---------------------------------------------------------------------------
+STAGE         := $(CURDIR)/build/stage
+STAGE_LIBDIR  := $(STAGE)/lib
+STAGE_PC_PATH := $(STAGE_LIBDIR)/pkgconfig
+# pkg-config against the staged install only (PKG_CONFIG_LIBDIR would also
+# hide lapacke/check; only odhs is looked up, so PKG_CONFIG_PATH suffices).
+STAGE_PKG_CONFIG := PKG_CONFIG_PATH=$(STAGE_PC_PATH) $(PKG_CONFIG)
+STAGE_RPATH      := -Wl,-rpath,$(STAGE_LIBDIR)
+
+# Flags for programs built as outside consumers: no -I of our own, only
+# what pkg-config says. Warnings on, so the public headers stay clean.
+CONSUMER_CFLAGS ?= -std=c11 -O2 -g -Wall -Wextra -Wpedantic -Werror
+
+EXAMPLE_SRCS := $(sort $(wildcard examples/*.c))
+EXAMPLE_BINS := $(EXAMPLE_SRCS:examples/%.c=build/examples/%)
+
+PCTEST_DIR    := build/pkgconfig-test
+PCTEST_SHARED := $(PCTEST_DIR)/consumer-shared
+PCTEST_STATIC := $(PCTEST_DIR)/consumer-static
+
+BENCH_SRCS := $(sort $(wildcard bench/*.c))
+BENCH_BINS := $(BENCH_SRCS:bench/%.c=build/bench/%)
+
+# ---------------------------------------------------------------------------
+# Flag tracking: objects depend on a file holding the compile command, so
+# changing SUITESPARSE/OPTFLAGS/CC/... rebuilds them. The file is rewritten
+# only when its content changes (move-if-change).
+# ---------------------------------------------------------------------------
+FLAGS_STAMP := $(BUILD)/compile-flags.txt
+
+# $(call write_if_changed,file,content)
+define write_if_changed
+	@mkdir -p $(dir $(1))
+	@printf '%s\n' $(2) > $(1).tmp
+	@if cmp -s $(1).tmp $(1); then rm -f $(1).tmp; else mv -f $(1).tmp $(1); fi
+endef
+
+.PHONY: FORCE
+FORCE:
+
+$(FLAGS_STAMP): FORCE
+	$(call write_if_changed,$@,'$(LIB_COMPILE) | $(LDFLAGS) $(LDLIBS) | $(ODHS_LIBS)')
+
+# Likewise the lists of linked objects, so that deleting a source file
+# relinks the library / the test runner.
+LIB_OBJS_STAMP  := $(BUILD)/lib-objects.txt
+TEST_OBJS_STAMP := $(BUILD)/test-objects.txt
+
+$(LIB_OBJS_STAMP): FORCE
+	$(call write_if_changed,$@,$(LIB_OBJS))
+
+$(TEST_OBJS_STAMP): FORCE
+	$(call write_if_changed,$@,$(TEST_OBJS))
+
+# ===========================================================================
+# Library
+# ===========================================================================
+.PHONY: all lib static shared
+all: static shared
+lib: all
+static: $(STATIC_LIB)
+shared: $(SHARED_REAL) $(SHARED_SONAME) $(SHARED_DEVLINK)
+
+$(OBJDIR)/lib/%.o: lib/%.c $(FLAGS_STAMP)
+	@mkdir -p $(@D)
+	$(LIB_COMPILE) -c -o $@ $<
+
+# Recreate the archive from scratch so objects of deleted sources vanish.
+$(STATIC_LIB): $(LIB_OBJS) $(LIB_OBJS_STAMP)
+	@mkdir -p $(@D)
+	@rm -f $@
+	$(AR) rcs $@ $(LIB_OBJS)
+
+# --no-undefined: every symbol must resolve against the listed libraries.
+$(SHARED_REAL): $(LIB_OBJS) $(LIB_OBJS_STAMP)
+	@mkdir -p $(@D)
+	$(CC) -shared $(ODHS_CFLAGS) $(CFLAGS) $(LDFLAGS) -Wl,-soname,$(SONAME) \
+	    -Wl,--no-undefined -o $@ $(LIB_OBJS) $(ODHS_LIBS) $(LDLIBS)
+
+$(SHARED_SONAME): $(SHARED_REAL)
+	ln -sf $(notdir $<) $@
+
+$(SHARED_DEVLINK): $(SHARED_SONAME)
+	ln -sf $(notdir $<) $@
+
+# ===========================================================================
+# Tests
+# ===========================================================================
+.PHONY: check check-run check-asan check-symbols check-readme tests
+
+# deps-if-missing runs first, then a fresh make instance does the work, so
+# that SUITESPARSE=auto and the pkg-config lookups see freshly installed
+# packages and `make -j check` cannot start compiling before apt-get is done.
+check: deps-if-missing
+	@$(MAKE) --no-print-directory check-symbols check-readme check-run
+
+# Build the runner only.
+tests: $(TEST_RUNNER)
+
+check-run: $(TEST_RUNNER)
+	@echo "== running $(TEST_RUNNER) ($(TEST_ENV))"
+	$(TEST_ENV) ./$(TEST_RUNNER)
+
+# Same library and tests, separate tree, no -O2, sanitizers on, no fork.
+check-asan: deps-if-missing
+	@$(MAKE) --no-print-directory check-run \
+	    BUILD=$(ASAN_BUILD) OUT_LIBDIR=$(ASAN_BUILD)/lib \
+	    OPTFLAGS="-O1 -g" SANFLAGS="$(ASAN_SANFLAGS)" \
+	    TEST_ENV="$(ASAN_TEST_ENV)"
+
+# The README's C example must be examples/minimal.c (built by `make examples`),
+# so the example users copy is one that compiles and runs.
+check-readme:
+	@echo "== checking that README.md's C example is examples/minimal.c"
+	@awk '/^```c$$/{f=1;next} /^```$$/{if(f)exit} f' README.md > $(BUILD)/readme_example.c.tmp
+	@tail -n +2 examples/minimal.c | diff -u $(BUILD)/readme_example.c.tmp - \
+	    && echo "check-readme: ok" || { echo "check-readme: README.md and examples/minimal.c differ"; exit 1; }
+
+# Every dynamically exported, defined symbol must start with odhs_. nm type
+# letters: T/t text, D/d data, B/b bss, R/r rodata, V/W weak, i ifunc, u
+# unique; A (absolute, e.g. version nodes) is not a real export and is skipped.
+check-symbols: $(SHARED_REAL)
+	@echo "== checking exported symbols of $<"
+	@nm -D --defined-only $< | awk ' \
+	    NF >= 3 && $$2 !~ /^[AaNn]$$/ && $$3 !~ /^odhs_/ \
+	        { print "  bad export: " $$0; bad = 1 } \
+	    NF >= 3 && $$3 ~ /^odhs_/ { n++ } \
+	    END { if (bad) { print "check-symbols: FAILED (only odhs_* may be exported)"; exit 1 } \
+	          printf "check-symbols: ok (%d odhs_* symbols exported)\n", n }'
+
+# suites.inc: one ODHS_SUITE(make_<module>_suite) line per tests/check_*.c.
+# Regenerated on every run but only rewritten when the list changes.
+$(SUITES_INC): FORCE
+	$(call write_if_changed,$@,'/* generated by the Makefile from tests/check_*.c: do not edit */' \
+	    $(foreach m,$(TEST_MODULES),'ODHS_SUITE(make_$(m)_suite)'))
+
+$(OBJDIR)/tests/%.o: tests/%.c $(FLAGS_STAMP)
+	@mkdir -p $(@D)
+	$(TEST_COMPILE) -c -o $@ $<
+
+# The runner includes the generated list (explicit: needed before the first
+# .d file exists).
+$(OBJDIR)/$(TEST_RUNNER_MAIN:.c=.o): $(SUITES_INC)
+
+$(TEST_RUNNER): $(TEST_OBJS) $(STATIC_LIB) $(TEST_OBJS_STAMP)
+	@mkdir -p $(@D)
+	$(CC) $(ODHS_CFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $(TEST_OBJS) $(STATIC_LIB) \
+	    $(ODHS_LIBS) $(CHECK_LIBS) $(LDLIBS)
+
+# ===========================================================================
+# Install / uninstall
+# ===========================================================================
+.PHONY: install uninstall
+
+PC_FILE := $(BUILD)/odhs.pc
+
+# Directories under PREFIX are written as ${prefix}/... in odhs.pc, so that
+# `pkg-config --define-prefix` can relocate an installed tree.
+pc_relative = $(patsubst $(PREFIX)/%,$${prefix}/%,$(1))
+
+# Regenerated whenever the substituted values change (PREFIX, SUITESPARSE...).
+$(PC_FILE): pkgconfig/odhs.pc.in FORCE
+	@mkdir -p $(@D)
+	@sed -e 's|@PREFIX@|$(PREFIX)|g' \
+	     -e 's|@LIBDIR@|$(call pc_relative,$(LIBDIR))|g' \
+	     -e 's|@INCLUDEDIR@|$(call pc_relative,$(INCLUDEDIR))|g' \
+	     -e 's|@VERSION@|$(VERSION)|g' \
+	     -e 's|@LIBS_PRIVATE@|$(LIBS_PRIVATE)|g' \
+	     $< > $@.tmp
+	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv -f $@.tmp $@; fi
+
+install: all $(PC_FILE)
+	$(INSTALL) -d $(DESTDIR)$(INCLUDEDIR)/odhs $(DESTDIR)$(LIBDIR)/pkgconfig
+	$(INSTALL) -m 644 include/odhs.h $(DESTDIR)$(INCLUDEDIR)/odhs.h
+	$(INSTALL) -m 644 $(filter include/odhs/%,$(PUBLIC_HEADERS)) $(DESTDIR)$(INCLUDEDIR)/odhs/
+	$(INSTALL) -m 644 $(STATIC_LIB) $(DESTDIR)$(LIBDIR)/libodhs.a
+	$(INSTALL) -m 755 $(SHARED_REAL) $(DESTDIR)$(LIBDIR)/libodhs.so.$(VERSION)
+	ln -sf libodhs.so.$(VERSION) $(DESTDIR)$(LIBDIR)/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libodhs.so
+	$(INSTALL) -m 644 $(PC_FILE) $(DESTDIR)$(LIBDIR)/pkgconfig/odhs.pc
+
+uninstall:
+	rm -f $(DESTDIR)$(INCLUDEDIR)/odhs.h
+	rm -f $(addprefix $(DESTDIR)$(INCLUDEDIR)/odhs/,$(notdir $(filter include/odhs/%,$(PUBLIC_HEADERS))))
+	-rmdir $(DESTDIR)$(INCLUDEDIR)/odhs 2>/dev/null || true
+	rm -f $(DESTDIR)$(LIBDIR)/libodhs.a \
+	      $(DESTDIR)$(LIBDIR)/libodhs.so.$(VERSION) \
+	      $(DESTDIR)$(LIBDIR)/$(SONAME) \
+	      $(DESTDIR)$(LIBDIR)/libodhs.so \
+	      $(DESTDIR)$(LIBDIR)/pkgconfig/odhs.pc
+
+# ===========================================================================
+# Staged install, examples and the pkg-config consumer test
+# ===========================================================================
+.PHONY: stage examples examples-build pkgconfig-test demo
+
+# Install into build/stage exactly as a user would (all locations given
+# explicitly so a LIBDIR=... on the outer command line cannot leak in).
+stage: all
+	@$(MAKE) --no-print-directory install DESTDIR= PREFIX=$(STAGE) \
+	    LIBDIR=$(STAGE_LIBDIR) INCLUDEDIR=$(STAGE)/include \
+	    PC_FILE=build/stage-odhs.pc
+
+examples: stage
+	@$(MAKE) --no-print-directory examples-build pkgconfig-test-run
+
+examples-build: $(EXAMPLE_BINS)
+	@echo "examples: $(if $(EXAMPLE_BINS),built $(EXAMPLE_BINS),none in examples/)"
+
+# Only pkg-config output (plus an rpath to the stage) - no -Iinclude here.
+build/examples/%: examples/%.c $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
+	@mkdir -p $(@D)
+	$(CC) $(CONSUMER_CFLAGS) -o $@ $< \
+	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) $(STAGE_RPATH)
+
+pkgconfig-test: stage
+	@$(MAKE) --no-print-directory pkgconfig-test-run
+
+.PHONY: pkgconfig-test-run
+pkgconfig-test-run:
+	@mkdir -p $(PCTEST_DIR)
+	@echo "== pkg-config consumer, shared: $$($(STAGE_PKG_CONFIG) --cflags --libs odhs)"
+	$(CC) $(CONSUMER_CFLAGS) -o $(PCTEST_SHARED) $(TEST_STANDALONE) \
+	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) $(STAGE_RPATH)
+	./$(PCTEST_SHARED)
+	@readelf -d $(PCTEST_SHARED) | grep -q 'NEEDED.*\[$(SONAME)\]' || \
+	    { echo "pkgconfig-test: $(PCTEST_SHARED) does not need $(SONAME)"; exit 1; }
+	@# Static: link libodhs.a (-lodhs -> -l:libodhs.a, since the linker would
+	@# otherwise prefer the .so) with `pkg-config --static` Libs.private.
+	@echo "== pkg-config consumer, static: $$($(STAGE_PKG_CONFIG) --static --cflags --libs odhs)"
+	$(CC) $(CONSUMER_CFLAGS) -o $(PCTEST_STATIC) $(TEST_STANDALONE) \
+	    $$($(STAGE_PKG_CONFIG) --cflags odhs) \
+	    $$($(STAGE_PKG_CONFIG) --static --libs odhs | sed 's/\(^\|[[:space:]]\)-lodhs\([[:space:]]\|$$\)/\1-l:libodhs.a\2/')
+	./$(PCTEST_STATIC)
+	@! readelf -d $(PCTEST_STATIC) | grep -q 'NEEDED.*libodhs' || \
+	    { echo "pkgconfig-test: $(PCTEST_STATIC) still needs libodhs.so"; exit 1; }
+	@echo "pkgconfig-test: ok"
+
+demo:
+	@$(MAKE) --no-print-directory deps-if-missing
+	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory examples
+	./build/examples/shear_flow
+
+# ===========================================================================
+# Benchmarks (static library; may include internal.h)
+# ===========================================================================
+.PHONY: bench
+bench: $(BENCH_BINS)
+	@echo "bench: $(if $(BENCH_BINS),built $(BENCH_BINS),none in bench/)"
+
+build/bench/%: bench/%.c $(STATIC_LIB) $(FLAGS_STAMP)
+	@mkdir -p $(@D)
+	$(CC) $(ODHS_CPPFLAGS) $(CPPFLAGS) $(ODHS_CFLAGS) $(CFLAGS) -MMD -MP \
+	    $(LDFLAGS) -o $@ $< $(STATIC_LIB) $(ODHS_LIBS) $(LDLIBS)
+
+# ===========================================================================
+# Dependencies (Debian/Ubuntu)
+# ===========================================================================
+.PHONY: deps deps-if-missing
+DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
+                 check pkg-config gcc make
+
+deps:
+	@if [ "$$(id -u)" -eq 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	set -x; \
+	$$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update && \
+	$$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y $(DEPS_PACKAGES)
+
+# The CHOLMOD header is only required unless SUITESPARSE=0 was asked for.
+deps-if-missing:
+	@missing=; \
+	command -v $(PKG_CONFIG) >/dev/null 2>&1 || missing="$$missing pkg-config"; \
+	command -v $(firstword $(CC)) >/dev/null 2>&1 || missing="$$missing $(firstword $(CC))"; \
+	for m in check lapacke lapack blas; do \
+	    $(PKG_CONFIG) --exists $$m 2>/dev/null || missing="$$missing $$m"; \
+	done; \
+	if [ "$(filter 0 no off false,$(SUITESPARSE))" = "" ] && \
+	   [ ! -f $(SUITESPARSE_INC)/cholmod.h ]; then missing="$$missing cholmod.h"; fi; \
+	if [ -n "$$missing" ]; then \
+	    echo "deps-if-missing: missing:$$missing -> running make deps"; \
+	    $(MAKE) --no-print-directory deps; \
+	fi
+
+# ===========================================================================
+# Housekeeping
+# ===========================================================================
+.PHONY: clean help
+
+clean:
+	rm -rf build build-asan
+	rm -f lib/*.a lib/*.so lib/*.so.*
+
+# Prints the comment block at the top of this file.
+help:
+	@awk 'NR > 2 && !/^#/ { exit } NR > 2 { sub(/^# ?/, ""); print }' $(firstword $(MAKEFILE_LIST))
+
+# Header dependencies (-MMD -MP) of everything compiled so far.
+-include $(LIB_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_BINS:=.d)

@@ -1,0 +1,90 @@
+/*
+ * libodhs - driver.h: what drives the particles.
+ *
+ * Overdamped dynamics with Stokes drag: F_drag = -xi0^{-1} (V - V_aff), with
+ * xi0 the mobility (time/mass). The imposed affine flow is V_aff = G R with
+ * velocity gradient
+ *     G = gammadot e_x e_y^T  -  c I,       c = compression_rate
+ *                                            (or c = kappa*gammadot at fixed p)
+ * (simple shear in the x-y plane with Lees-Edwards boundaries, plus isotropic
+ * compression for c > 0). The box deforms with the same G, so the flow is
+ * continuous across the periodic boundaries. External forces F_ext act on
+ * particles (fixed vector or user callback); forces and flow can be combined.
+ *
+ * Between events the contact forces solve N f = -S (V_aff + xi0 F_ext) / xi0
+ * and V = V_aff + xi0 (F_ext + S^T f) (eqs. 11-12 and 18-19 of the paper).
+ *
+ * Fixed pressure (Sect. II C): with a shear rate set, kappa is recomputed at
+ * every force computation so that p = <f|r>/(Omega d) equals the target
+ * (eq. 25 with the sign typo of eqs. 21/23 corrected: V_aff = gammadot (R_y x
+ * - kappa R), kappa > 0 compresses).
+ *
+ * Natural time unit tau (the stepper's step size is measured in it, which
+ * makes trajectories rate-invariant, Sect. II D): 1/max(|gammadot|, |c|) when
+ * a flow is set; otherwise lambda / (xi0 f_rms) for fixed forces, with lambda
+ * the mean diameter and f_rms = sqrt(<F|F>/N); otherwise the value set with
+ * odhs_driver_set_time_unit (default: lambda / xi0, i.e. unit force).
+ */
+#ifndef ODHS_DRIVER_H
+#define ODHS_DRIVER_H
+
+#include "odhs/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct odhs_driver odhs_driver;
+
+/**
+ * External force callback: fill F[0..N*dim-1] with the forces at time t on the
+ * configuration sys. Return 0 on success, nonzero to signal failure (the
+ * stepper then returns ODHS_E_CALLBACK and rolls the step back).
+ */
+typedef int (*odhs_force_fn)(double t, const odhs_system *sys, double *F, void *ctx);
+
+/** Create a driver: no flow, no forces, xi0 = 1. */
+ODHS_API int odhs_driver_create(odhs_driver **out);
+/** Destroy; NULL is a no-op. */
+ODHS_API void odhs_driver_destroy(odhs_driver *drv);
+/** Last error message ("" if none). */
+ODHS_API const char *odhs_driver_errmsg(const odhs_driver *drv);
+
+/** Mobility xi0 > 0 (default 1). */
+ODHS_API int odhs_driver_set_mobility(odhs_driver *drv, double xi0);
+/** Simple shear rate gammadot (any finite value; 0 turns shear off). */
+ODHS_API int odhs_driver_set_shear_rate(odhs_driver *drv, double gammadot);
+/** Isotropic compression rate c (V_aff = -c R; c < 0 dilates; 0 = off). */
+ODHS_API int odhs_driver_set_compression_rate(odhs_driver *drv, double c);
+/**
+ * Shear at fixed pressure p > 0 (requires a nonzero shear rate and no
+ * compression rate when stepping). kappa is clamped to [-kappa_max,
+ * kappa_max] (default 100), which only matters when the contacts cannot carry
+ * the pressure (for example when there are none).
+ */
+ODHS_API int odhs_driver_set_pressure(odhs_driver *drv, double p);
+/** Turn pressure control off (back to fixed volume). */
+ODHS_API int odhs_driver_clear_pressure(odhs_driver *drv);
+/** Bound on |kappa| under pressure control (> 0). */
+ODHS_API int odhs_driver_set_kappa_max(odhs_driver *drv, double kappa_max);
+/** Fixed external forces F[0..n*dim-1] (copied); F == NULL removes them.
+ *  Replaces any force callback. */
+ODHS_API int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const double *F);
+/** Force callback (fn == NULL removes it). Replaces any fixed forces. */
+ODHS_API int odhs_driver_set_force_callback(odhs_driver *drv, odhs_force_fn fn, void *ctx);
+/** Natural time unit for callback-driven runs (> 0). */
+ODHS_API int odhs_driver_set_time_unit(odhs_driver *drv, double tau);
+
+/** Getters. */
+ODHS_API int odhs_driver_get_shear_rate(const odhs_driver *drv, double *gammadot);
+ODHS_API int odhs_driver_get_compression_rate(const odhs_driver *drv, double *c);
+ODHS_API int odhs_driver_get_mobility(const odhs_driver *drv, double *xi0);
+/** Target pressure; *enabled = 0 when pressure control is off. */
+ODHS_API int odhs_driver_get_pressure(const odhs_driver *drv, double *p, int *enabled);
+/** Natural time unit tau for this driver acting on sys (see above). */
+ODHS_API int odhs_driver_time_unit(const odhs_driver *drv, const odhs_system *sys, double *tau);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ODHS_DRIVER_H */

@@ -1,0 +1,52 @@
+/*
+ * libodhs - io.h: configuration files (extended XYZ).
+ *
+ * Format written (one frame):
+ *   line 1: N
+ *   line 2: Lattice="ax ay az bx by bz cx cy cz" Properties=species:S:1:pos:R:3:radius:R:1
+ *           pbc="T T T" dim=D strain=GAMMA
+ *   then N lines: species x y z radius
+ * with a = (Lx,0,0), b = (gamma*Ly, Ly, 0), c = (0,0,Lz) the sheared cell. In 2D
+ * z = 0, c = (0,0,1) and pbc="T T F". Numbers are written with 17 significant
+ * digits, so a write/read round trip is bit-exact. OVITO and ASE read these
+ * files directly.
+ *
+ * The reader accepts any extended XYZ frame whose Properties contain species
+ * (S:1), pos (R:3) and radius (R:1) columns in any order, with other columns
+ * ignored; keys may appear in any order; dim defaults to 3, or 2 when pbc's
+ * third flag is F; strain defaults to bx/Ly. Orthogonal-cell lattices only
+ * (apart from the x-y shear). Malformed input gives ODHS_E_FORMAT with a message
+ * naming the line, and never a half-filled system.
+ */
+#ifndef ODHS_IO_H
+#define ODHS_IO_H
+
+#include "odhs/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * Read an extended XYZ file into a new system (*out). On error *out is NULL and,
+ * if errbuf is not NULL, a message (naming the line) is copied into errbuf.
+ * Errors: ODHS_E_NULL, ODHS_E_IO, ODHS_E_FORMAT, ODHS_E_NOMEM and the validation
+ * errors of odhs_system_set_configuration (ODHS_E_OVERLAP, ODHS_E_BOX, ...).
+ */
+ODHS_API int odhs_xyz_read(const char *path, odhs_system **out, char *errbuf, size_t errlen);
+
+/** As odhs_xyz_read, from a memory buffer of len bytes (need not be NUL-ended). */
+ODHS_API int odhs_xyz_parse(const char *buf, size_t len, odhs_system **out, char *errbuf,
+                            size_t errlen);
+
+/**
+ * Write the system to path in the format above (the file is written to a
+ * temporary name and renamed, so a failed write leaves any old file intact).
+ * Errors: ODHS_E_NULL, ODHS_E_STATE (radii/positions unset), ODHS_E_IO.
+ */
+ODHS_API int odhs_xyz_write(const odhs_system *sys, const char *path);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ODHS_IO_H */

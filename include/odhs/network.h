@@ -1,0 +1,113 @@
+/*
+ * libodhs - network.h: the contact network and the operator S.
+ *
+ * A contact c joins particles i < j (ordered so) along the minimum-image
+ * separation R_ij = R_j - R_i with unit normal n_c = R_ij / r_ij. Its row of the
+ * operator S (Nc x N*dim) holds -n_c on particle i's block and +n_c on j's, so
+ * (S V)_c = (V_j - V_i).n_c is the rate of change of r_ij and (S^T f) is the
+ * contact force on every particle (eqs. 1-8 of Lerner, During & Wyart 2013).
+ * N = S S^T. Forces f_c > 0 are repulsive.
+ *
+ * Kinds: ODHS_CONTACT_TEMPORARY contacts open when their force would turn
+ * negative; ODHS_CONTACT_PERMANENT contacts (bonds of composite particles)
+ * never open and may carry negative force.
+ *
+ * Contact indices (0..Nc-1) are positions in the current list and change when
+ * contacts are added or removed; pairs (i,j) are the stable identities.
+ */
+#ifndef ODHS_NETWORK_H
+#define ODHS_NETWORK_H
+
+#include "odhs/system.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct odhs_network odhs_network;
+
+enum {
+    ODHS_CONTACT_TEMPORARY = 0,
+    ODHS_CONTACT_PERMANENT = 1
+};
+
+/** Create an empty network for the particles of sys (the network remembers N
+ *  and the dimension; geometry is read from a system on update). */
+ODHS_API int odhs_network_create(const odhs_system *sys, odhs_network **out);
+/** Destroy a network; NULL is a no-op. */
+ODHS_API void odhs_network_destroy(odhs_network *net);
+/** Last error message on this handle ("" if none). */
+ODHS_API const char *odhs_network_errmsg(const odhs_network *net);
+
+/** Add the contact (i,j) of the given kind (ODHS_CONTACT_*). Errors:
+ *  ODHS_E_RANGE, ODHS_E_INVALID (i == j, bad kind, already present). */
+ODHS_API int odhs_network_add(odhs_network *net, size_t i, size_t j, int kind);
+/** Remove the contact (i,j). ODHS_E_INVALID if absent. */
+ODHS_API int odhs_network_remove(odhs_network *net, size_t i, size_t j);
+/** Remove every contact. */
+ODHS_API int odhs_network_clear(odhs_network *net);
+/** Whether (i,j) is a contact: *index receives its index or SIZE_MAX. */
+ODHS_API int odhs_network_find(const odhs_network *net, size_t i, size_t j, size_t *index);
+
+/**
+ * Add, as temporary contacts, all pairs of sys whose gap |r_ij| - (a_i + a_j)
+ * is at most tol * (a_i + a_j) (tol >= 0), then update the geometry.
+ */
+ODHS_API int odhs_network_detect(odhs_network *net, const odhs_system *sys, double tol);
+/** Recompute normals, distances and gaps of all contacts from sys. */
+ODHS_API int odhs_network_update_geometry(odhs_network *net, const odhs_system *sys);
+
+/** Number of contacts Nc. */
+ODHS_API size_t odhs_network_count(const odhs_network *net);
+/** Number of particles N and dimension d the network was made for. */
+ODHS_API size_t odhs_network_particles(const odhs_network *net);
+ODHS_API int odhs_network_dim(const odhs_network *net);
+
+/** Contact k: particles (*i < *j), kind; any output may be NULL. */
+ODHS_API int odhs_network_get_contact(const odhs_network *net, size_t k, size_t *i, size_t *j,
+                                      int *kind);
+/** Copy per-contact data (Nc entries; normals Nc*dim) as of the last geometry
+ *  update / force computation. */
+ODHS_API int odhs_network_get_forces(const odhs_network *net, double *f);
+ODHS_API int odhs_network_get_gaps(const odhs_network *net, double *gap);
+ODHS_API int odhs_network_get_normals(const odhs_network *net, double *n);
+/** Set the forces (Nc entries), e.g. from a user solve. */
+ODHS_API int odhs_network_set_forces(odhs_network *net, const double *f);
+
+/** out(Nc) = S v, v of length N*dim. */
+ODHS_API int odhs_network_apply_S(const odhs_network *net, const double *v, double *out);
+/** out(N*dim) = S^T f. */
+ODHS_API int odhs_network_apply_ST(const odhs_network *net, const double *f, double *out);
+/** out(Nc) = N x = S S^T x; work must hold N*dim doubles (or be NULL: then the
+ *  call allocates). */
+ODHS_API int odhs_network_apply_N(const odhs_network *net, const double *x, double *out,
+                                  double *work);
+/** Number of nonzeros of S (2*dim per contact). */
+ODHS_API size_t odhs_network_nnz(const odhs_network *net);
+/** S in compressed sparse row form: rowptr[Nc+1], col[nnz], val[nnz]. */
+ODHS_API int odhs_network_get_S_csr(const odhs_network *net, size_t *rowptr, size_t *col,
+                                    double *val);
+
+/** Mean coordination z = 2 Nc / N. */
+ODHS_API int odhs_network_coordination(const odhs_network *net, double *z);
+
+/**
+ * Constrained subset (Sect. IV D): particles with at least d+1 contacts to
+ * other particles of the subset, found by iterative removal (integer
+ * arithmetic). Outputs (any may be NULL): *nbar its size, *ncon the number of
+ * contacts inside it, in_subset[N] flags (1 = constrained), and *zbar_num,
+ * the numerator 2(d-1) + sum_i zbar_i of eq. (29) so that zbar = zbar_num/nbar.
+ * Particles outside the subset are the rattlers (and loosely connected ones).
+ */
+ODHS_API int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon,
+                                      unsigned char *in_subset, long *zbar_num);
+/**
+ * Whether the constrained subset is potentially jammed: Ncon >= d(Nbar-1)+1
+ * (equivalently zbar >= 2d, eq. 29, in integers). *flag = 1 or 0.
+ */
+ODHS_API int odhs_network_potentially_jammed(const odhs_network *net, int *flag);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ODHS_NETWORK_H */

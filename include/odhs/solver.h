@@ -1,0 +1,97 @@
+/*
+ * libodhs - solver.h: pluggable linear solvers for N f = b with N = S S^T.
+ *
+ * A backend is a const table of functions (odhs_solver_type). Built-in
+ * backends are exported as constants and can be looked up by name; user
+ * backends fill their own table. The library wraps every backend: it checks
+ * the result (residual and finiteness) and records statistics.
+ */
+#ifndef ODHS_SOLVER_H
+#define ODHS_SOLVER_H
+
+#include "odhs/network.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Version of odhs_solver_type understood by this library. */
+#define ODHS_SOLVER_TYPE_VERSION 1
+
+/* capability flags */
+#define ODHS_SOLVER_ITERATIVE 0x1u /* result depends on a tolerance          */
+#define ODHS_SOLVER_DIRECT 0x2u    /* factorisation-based                     */
+#define ODHS_SOLVER_USES_GUESS 0x4u /* uses x on input as initial guess       */
+
+/**
+ * A solver backend. Required: version, name, create, destroy, solve. Optional
+ * (may be NULL; the library supplies defaults): setup, set_param, get_stat.
+ * Functions return ODHS_OK or an error code (ODHS_E_SINGULAR, ODHS_E_NOCONV,
+ * ODHS_E_NOMEM, ...).
+ */
+typedef struct odhs_solver_type {
+    int version;       /* ODHS_SOLVER_TYPE_VERSION                         */
+    const char *name;  /* short unique name, e.g. "cg"                     */
+    unsigned flags;    /* ODHS_SOLVER_* capability flags                   */
+    /** Allocate the backend state. */
+    int (*create)(void **state);
+    /** Free the backend state (NULL-safe). */
+    void (*destroy)(void *state);
+    /** The network's contacts or geometry changed (called before solve
+     *  whenever that happened since the last call). */
+    int (*setup)(void *state, const odhs_network *net);
+    /** Solve N x = b (b and x of length Nc). With ODHS_SOLVER_USES_GUESS, x
+     *  holds an initial guess on input. Use the odhs_network_* functions to
+     *  access S. */
+    int (*solve)(void *state, const odhs_network *net, const double *b, double *x);
+    /** Set a named numeric parameter; ODHS_E_INVALID for unknown names. */
+    int (*set_param)(void *state, const char *key, double value);
+    /** Get a named statistic of the last solve (e.g. "iterations"). */
+    int (*get_stat)(void *state, const char *key, double *value);
+} odhs_solver_type;
+
+/** Preconditioned (Jacobi) conjugate gradient, matrix-free on S S^T.
+ *  Parameters: "tol" (relative residual, default 1e-12), "maxiter" (default
+ *  0 = 10*Nc + 100). Statistics: "iterations". Warm-started from the previous
+ *  forces by the stepper. */
+ODHS_API extern const odhs_solver_type odhs_solver_type_cg;
+/** Dense Cholesky of N through LAPACK dpotrf/dpotrs. Reports a non-positive
+ *  pivot (singular or hyperstatic network) as ODHS_E_SINGULAR. O(Nc^3). */
+ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
+
+typedef struct odhs_solver odhs_solver;
+
+/** Create a solver handle for a backend type (user or built-in). The table
+ *  must outlive the handle. ODHS_E_INVALID for a malformed table. */
+ODHS_API int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out);
+/** Create a built-in solver by name: "cg", "dense". Names of backends not
+ *  built into this library ("cholmod", "spqr") give ODHS_E_NOTINSTALLED;
+ *  unknown names ODHS_E_INVALID. */
+ODHS_API int odhs_solver_create_by_name(const char *name, odhs_solver **out);
+/** Destroy; NULL is a no-op. */
+ODHS_API void odhs_solver_destroy(odhs_solver *s);
+/** Last error message ("" if none). */
+ODHS_API const char *odhs_solver_errmsg(const odhs_solver *s);
+/** Backend name. */
+ODHS_API const char *odhs_solver_name(const odhs_solver *s);
+/** Set a backend parameter (see each backend). */
+ODHS_API int odhs_solver_set_param(odhs_solver *s, const char *key, double value);
+/**
+ * Statistics: "iterations" (backend), "residual" (relative residual
+ * |N x - b| / |b| of the last solve, computed by the library), "solves" (count).
+ */
+ODHS_API int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value);
+/** Set the relative residual above which a solve is reported as failed
+ *  (default 1e-6; ODHS_E_NOCONV for iterative, ODHS_E_SINGULAR for direct). */
+ODHS_API int odhs_solver_set_check_tolerance(odhs_solver *s, double tol);
+/**
+ * Solve N x = b on the network's current geometry. If the network changed
+ * since the last solve the backend's setup runs first. x holds the initial
+ * guess for backends that use one (pass zeros otherwise).
+ */
+ODHS_API int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ODHS_SOLVER_H */

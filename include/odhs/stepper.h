@@ -1,0 +1,141 @@
+/*
+ * libodhs - stepper.h: the event-driven integrator (Sect. IV of the paper).
+ *
+ * The stepper advances a system under a driver. Each step moves the particles
+ * along their current velocities for dt (in the driver's natural time unit
+ * tau, see driver.h), truncated at the first collision among particles not in
+ * contact (predicted exactly for the straight-line motion of the step). After
+ * the move the contact forces are recomputed; contacts whose force would be
+ * negative are removed and approaching removed pairs re-connected by the
+ * rewiring procedure of Sect. IV B, which yields the unique valid network
+ * (Appendix A). Every `correction_interval` steps the contact-distance drift
+ * is removed (Sect. IV C).
+ *
+ * The stepper borrows the system, driver and solver: they must outlive it and
+ * must not be modified behind its back while it runs (change them, then call
+ * odhs_stepper_reset).
+ *
+ * Time is physical time; strain is the accumulated shear strain
+ * integral(gammadot dt) (the system's Lees-Edwards strain is that value
+ * remapped into [-1/2, 1/2]).
+ */
+#ifndef ODHS_STEPPER_H
+#define ODHS_STEPPER_H
+
+#include "odhs/driver.h"
+#include "odhs/network.h"
+#include "odhs/solver.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct odhs_stepper odhs_stepper;
+
+/** Event kinds (pinned values). */
+enum {
+    ODHS_EVENT_NONE = 0,
+    ODHS_EVENT_COLLISION = 1, /* a new contact formed                        */
+    ODHS_EVENT_OPENING = 2    /* a contact opened (its force reached zero)   */
+};
+
+/** One event. Passed to callbacks; may gain fields at the end in later
+ *  versions, so never allocate it by value across a library upgrade boundary
+ *  except as returned by the library. */
+typedef struct odhs_event {
+    int kind;      /* ODHS_EVENT_*                                   */
+    size_t i, j;   /* the pair, i < j                                */
+    double time;   /* physical time of the event                     */
+    double strain; /* accumulated strain at the event                */
+} odhs_event;
+
+/** Event callback: return 0 to go on, nonzero to stop the run after the
+ *  current step (the run call then returns ODHS_STOPPED). */
+typedef int (*odhs_event_fn)(const odhs_event *ev, void *ctx);
+
+/** Create a stepper on sys (must be ready: radii and positions set). */
+ODHS_API int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
+                                 odhs_stepper **out);
+/** Destroy; NULL is a no-op. The system keeps its current configuration. */
+ODHS_API void odhs_stepper_destroy(odhs_stepper *st);
+/** Last error message ("" if none). */
+ODHS_API const char *odhs_stepper_errmsg(const odhs_stepper *st);
+
+/** Step size in units of tau (default 1e-3). */
+ODHS_API int odhs_stepper_set_dt(odhs_stepper *st, double dt);
+/** Drift correction every k steps (default 10; 0 disables). */
+ODHS_API int odhs_stepper_set_correction_interval(odhs_stepper *st, unsigned k);
+/** Relative gap (gap / (a_i + a_j)) below which pairs count as initial contacts
+ *  when the stepper starts (default 1e-9). */
+ODHS_API int odhs_stepper_set_contact_tolerance(odhs_stepper *st, double tol);
+/** Event callback (NULL removes). */
+ODHS_API int odhs_stepper_set_event_callback(odhs_stepper *st, odhs_event_fn fn, void *ctx);
+
+/**
+ * (Re)build the initial contact network from the system (pairs within the
+ * contact tolerance), compute the valid network, forces and velocities. Called
+ * automatically by the first step; call it again after changing the system,
+ * driver or solver. Time and strain are kept.
+ */
+ODHS_API int odhs_stepper_reset(odhs_stepper *st);
+
+/**
+ * Apply the drift correction of Sect. IV C now (contact gaps back to round-off,
+ * then re-solve and rewire), e.g. before saving a configuration. Events it
+ * causes go to the event callback. Returns like odhs_stepper_step.
+ */
+ODHS_API int odhs_stepper_correct(odhs_stepper *st);
+
+/**
+ * Take one step. *ev (may be NULL) receives the first event of the step, or
+ * kind ODHS_EVENT_NONE. Returns ODHS_OK, ODHS_POTENTIALLY_JAMMED (no step was
+ * taken: the constrained subset is isostatic), or an error (the configuration
+ * is rolled back to the start of the step).
+ */
+ODHS_API int odhs_stepper_step(odhs_stepper *st, odhs_event *ev);
+/** Step until physical time t (the last step is truncated to land on t). */
+ODHS_API int odhs_stepper_run_until_time(odhs_stepper *st, double t);
+/** Step until accumulated strain gamma (shear rate must be nonzero). */
+ODHS_API int odhs_stepper_run_until_strain(odhs_stepper *st, double gamma);
+/** Step until `count` more events have happened. */
+ODHS_API int odhs_stepper_run_events(odhs_stepper *st, uint64_t count);
+/** Step until the packing fraction reaches phi (compression or pressure
+ *  driving; the last step is truncated to land on phi). */
+ODHS_API int odhs_stepper_run_until_packing_fraction(odhs_stepper *st, double phi);
+
+/* ---- observables (of the current state) -------------------------------- */
+ODHS_API int odhs_stepper_time(const odhs_stepper *st, double *t);
+ODHS_API int odhs_stepper_strain(const odhs_stepper *st, double *gamma);
+/** Counters: steps, collisions, openings (any output may be NULL). */
+ODHS_API int odhs_stepper_counts(const odhs_stepper *st, uint64_t *steps, uint64_t *collisions,
+                                 uint64_t *openings);
+/** Stress tensor sigma_ab = -(1/Omega) sum_c f_c R_a R_b / r (dim*dim, row-major;
+ *  eq. 30 generalised, positive shear stress sigma_xy under positive shear). */
+ODHS_API int odhs_stepper_stress(const odhs_stepper *st, double *sigma);
+/** Shear stress sigma_xy. */
+ODHS_API int odhs_stepper_shear_stress(const odhs_stepper *st, double *sigma_xy);
+/** Pressure p = <f|r>/(Omega d) (eq. 24). */
+ODHS_API int odhs_stepper_pressure(const odhs_stepper *st, double *p);
+/** Current kappa (compression-to-shear rate ratio; 0 without pressure control
+ *  unless a compression rate is set, then c/gammadot or c when no shear). */
+ODHS_API int odhs_stepper_kappa(const odhs_stepper *st, double *kappa);
+/** Dissipation rate xi0^{-1} sum_k |V_k - V_aff,k|^2. */
+ODHS_API int odhs_stepper_dissipation(const odhs_stepper *st, double *D);
+/** Power injected: -<f|S V_aff> + <F_ext|V - V_aff> (equals the dissipation). */
+ODHS_API int odhs_stepper_power(const odhs_stepper *st, double *P);
+/** Velocities V (N*dim, lab frame, V_aff measured from the box origin). */
+ODHS_API int odhs_stepper_velocities(const odhs_stepper *st, double *V);
+/** Non-affine velocities V - V_aff (N*dim). */
+ODHS_API int odhs_stepper_nonaffine_velocities(const odhs_stepper *st, double *U);
+/** Mean coordination z = 2 Nc / N. */
+ODHS_API int odhs_stepper_coordination(const odhs_stepper *st, double *z);
+/** The current contact network (owned by the stepper; read only). */
+ODHS_API const odhs_network *odhs_stepper_network(const odhs_stepper *st);
+/** Largest |gap|/(a_i+a_j) over contacts and the largest overlap
+ *  -gap/(a_i+a_j) over all pairs (<= 0 if none); either may be NULL. */
+ODHS_API int odhs_stepper_errors(const odhs_stepper *st, double *contact_gap, double *overlap);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ODHS_STEPPER_H */

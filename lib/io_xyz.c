@@ -1,0 +1,842 @@
+/*
+ * libodhs - io_xyz.c: extended XYZ reader and writer (see include/odhs/io.h).
+ *
+ * Copyright (C) 2026 the libodhs authors. LGPL-2.1-or-later, see LICENSE.
+ *
+ * Reader design:
+ *  - The input is a byte buffer of known length that need not be NUL-ended;
+ *    it is only ever accessed through (pointer, length) spans, and numbers are
+ *    copied into a small NUL-ended scratch buffer before strtod sees them.
+ *  - Everything is parsed into temporary arrays and validated first; the
+ *    system is created only at the very end, so an error never leaves a
+ *    half-filled system behind (*out stays NULL).
+ *  - Only the first frame is read. After the N particle lines, trailing blank
+ *    lines are ignored; if more content follows it must look like the start of
+ *    another frame (a line holding a positive integer), which is then ignored.
+ *    Any other content is reported, because it usually means N is wrong.
+ *  - Numbers are parsed with strtod in the current C locale ("C" assumed, as
+ *    for the printf-based writer).
+ */
+#if !defined(_POSIX_C_SOURCE) || _POSIX_C_SOURCE < 200809L
+#undef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "internal.h"
+
+/* Largest particle count accepted from a file (keeps n*dim*sizeof(double)
+ * and friends far from overflow; the lines must also really be present). */
+#define XYZ_N_MAX ((size_t)100000000)
+/* Largest total number of columns in a Properties specification. */
+#define XYZ_COLS_MAX ((size_t)100000)
+/* Longest numeric token accepted. */
+#define XYZ_NUM_MAX 255
+
+/* ---- small helpers -------------------------------------------------------- */
+
+typedef struct {
+    const char *p;
+    size_t n;
+} span;
+
+typedef struct {
+    const char *buf;
+    size_t len;
+    size_t pos;
+    size_t lineno; /* 1-based number of the line last returned */
+} reader;
+
+static int is_ws(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+static char to_lower(char c)
+{
+    return (c >= 'A' && c <= 'Z') ? (char)(c - 'A' + 'a') : c;
+}
+
+/* case-insensitive comparison of a span with a NUL-ended literal */
+static int span_ieq(span s, const char *lit)
+{
+    size_t k = strlen(lit);
+    if (s.n != k) return 0;
+    for (size_t i = 0; i < k; i++)
+        if (to_lower(s.p[i]) != to_lower(lit[i])) return 0;
+    return 1;
+}
+
+/* Next line (without '\n' and a trailing '\r'); 0 at the end of the buffer. */
+static int next_line(reader *rd, span *line)
+{
+    if (rd->pos >= rd->len) return 0;
+    const char *start = rd->buf + rd->pos;
+    size_t rest = rd->len - rd->pos;
+    const char *nl = memchr(start, '\n', rest);
+    size_t n = nl ? (size_t)(nl - start) : rest;
+    rd->pos += nl ? n + 1 : n;
+    if (n > 0 && start[n - 1] == '\r') n--;
+    line->p = start;
+    line->n = n;
+    rd->lineno++;
+    return 1;
+}
+
+static span trim(span s)
+{
+    while (s.n > 0 && is_ws(s.p[0])) {
+        s.p++;
+        s.n--;
+    }
+    while (s.n > 0 && is_ws(s.p[s.n - 1])) s.n--;
+    return s;
+}
+
+/* Next white-space separated token of s starting at *i; 0 if none left. */
+static int next_token(span s, size_t *i, span *tok)
+{
+    size_t k = *i;
+    while (k < s.n && is_ws(s.p[k])) k++;
+    if (k >= s.n) {
+        *i = k;
+        return 0;
+    }
+    size_t start = k;
+    while (k < s.n && !is_ws(s.p[k])) k++;
+    tok->p = s.p + start;
+    tok->n = k - start;
+    *i = k;
+    return 1;
+}
+
+static size_t count_tokens(span s)
+{
+    size_t i = 0, c = 0;
+    span t;
+    while (next_token(s, &i, &t)) c++;
+    return c;
+}
+
+/* Length to print of a token in a message (tokens can be huge). */
+static int show_len(span s)
+{
+    return (int)(s.n > 40 ? 40 : s.n);
+}
+
+/* Parse a whole token as a double. 0 ok, -1 not a number, -2 not finite. */
+static int parse_double(span tok, double *out)
+{
+    char tmp[XYZ_NUM_MAX + 1];
+    if (tok.n == 0 || tok.n > XYZ_NUM_MAX) return -1;
+    memcpy(tmp, tok.p, tok.n);
+    tmp[tok.n] = '\0';
+    /* strtod would skip leading white space; tokens never have any, but a
+     * value taken from a quoted string might. */
+    if (is_ws(tmp[0]) || tmp[0] == '\n') return -1;
+    char *end = NULL;
+    double v = strtod(tmp, &end);
+    if (end != tmp + tok.n) return -1;
+    if (!isfinite(v)) return -2;
+    *out = v;
+    return 0;
+}
+
+/* Parse a token of decimal digits only as an unsigned count <= max.
+ * 0 ok, -1 not a non-negative integer, -2 larger than max. */
+static int parse_count(span tok, size_t max, size_t *out)
+{
+    if (tok.n == 0) return -1;
+    size_t v = 0;
+    int big = 0;
+    for (size_t i = 0; i < tok.n; i++) {
+        char c = tok.p[i];
+        if (c < '0' || c > '9') return -1;
+        if (!big) {
+            v = v * 10 + (size_t)(c - '0');
+            if (v > max) big = 1;
+        }
+    }
+    if (big) return -2;
+    *out = v;
+    return 0;
+}
+
+/* A species label the library accepts: 1..ODHS_SPECIES_MAX printable ASCII
+ * characters without white space or quotes. */
+static int valid_label(span s)
+{
+    if (s.n < 1 || s.n > ODHS_SPECIES_MAX) return 0;
+    for (size_t i = 0; i < s.n; i++) {
+        unsigned char c = (unsigned char)s.p[i];
+        if (c <= 0x20 || c >= 0x7f || c == '"' || c == '\'' || c == '=') return 0;
+    }
+    return 1;
+}
+
+/* ---- the comment line ----------------------------------------------------- */
+
+typedef struct {
+    int dim;
+    double L[3];
+    double gamma;
+    size_t ncols;    /* columns per particle line */
+    size_t col_sp;   /* species column */
+    size_t col_pos;  /* first of three position columns */
+    size_t col_rad;  /* radius column */
+} header;
+
+/* Split a list value (Lattice) into numbers: separators are white space,
+ * commas and brackets. Returns the count found (up to max stored), or -1 on a
+ * bad number with *bad set to it. */
+static long parse_number_list(span v, double *vals, size_t max, span *bad, int *nonfinite)
+{
+    size_t i = 0, cnt = 0;
+    while (i < v.n) {
+        char c = v.p[i];
+        if (is_ws(c) || c == ',' || c == '[' || c == ']' || c == '{' || c == '}') {
+            i++;
+            continue;
+        }
+        size_t start = i;
+        while (i < v.n) {
+            c = v.p[i];
+            if (is_ws(c) || c == ',' || c == '[' || c == ']' || c == '{' || c == '}') break;
+            i++;
+        }
+        span tok = {v.p + start, i - start};
+        double d = 0.0;
+        int rc = parse_double(tok, &d);
+        if (rc != 0) {
+            *bad = tok;
+            *nonfinite = (rc == -2);
+            return -1;
+        }
+        if (cnt < max) vals[cnt] = d;
+        cnt++;
+    }
+    return (long)cnt;
+}
+
+static int parse_flag(span t, int *flag)
+{
+    if (span_ieq(t, "t") || span_ieq(t, "true") || span_ieq(t, "1")) {
+        *flag = 1;
+        return 0;
+    }
+    if (span_ieq(t, "f") || span_ieq(t, "false") || span_ieq(t, "0")) {
+        *flag = 0;
+        return 0;
+    }
+    return -1;
+}
+
+/* Properties=name:type:count:... -> columns of species, pos, radius. */
+static int parse_properties(span v, size_t lineno, header *h, char *msg)
+{
+    size_t i = 0, field = 0, col = 0;
+    span name = {NULL, 0}, type = {NULL, 0};
+    int have_sp = 0, have_pos = 0, have_rad = 0;
+    for (;;) {
+        size_t start = i;
+        while (i < v.n && v.p[i] != ':') i++;
+        span f = {v.p + start, i - start};
+        int last = (i >= v.n);
+        switch (field % 3) {
+        case 0:
+            if (f.n == 0)
+                return odhs__err(msg, ODHS_E_FORMAT,
+                                 "line %zu: Properties: empty column name", lineno);
+            name = f;
+            break;
+        case 1:
+            if (!(f.n == 1 && (span_ieq(f, "s") || span_ieq(f, "r") || span_ieq(f, "i") ||
+                               span_ieq(f, "l"))))
+                return odhs__err(msg, ODHS_E_FORMAT,
+                                 "line %zu: Properties: column '%.*s' has unknown type "
+                                 "'%.*s' (expected S, R, I or L)",
+                                 lineno, show_len(name), name.p, show_len(f), f.p);
+            type = f;
+            break;
+        default: {
+            size_t count = 0;
+            int rc = parse_count(f, XYZ_COLS_MAX, &count);
+            if (rc != 0 || count == 0)
+                return odhs__err(msg, ODHS_E_FORMAT,
+                                 "line %zu: Properties: column '%.*s' has invalid count '%.*s'",
+                                 lineno, show_len(name), name.p, show_len(f), f.p);
+            if (count > XYZ_COLS_MAX - col)
+                return odhs__err(msg, ODHS_E_FORMAT,
+                                 "line %zu: Properties: too many columns", lineno);
+            char t = to_lower(type.p[0]);
+            if (span_ieq(name, "species")) {
+                if (have_sp)
+                    return odhs__err(msg, ODHS_E_FORMAT,
+                                     "line %zu: Properties: duplicate column 'species'", lineno);
+                if (t != 's' || count != 1)
+                    return odhs__err(msg, ODHS_E_FORMAT,
+                                     "line %zu: Properties: 'species' must be S:1", lineno);
+                have_sp = 1;
+                h->col_sp = col;
+            } else if (span_ieq(name, "pos")) {
+                if (have_pos)
+                    return odhs__err(msg, ODHS_E_FORMAT,
+                                     "line %zu: Properties: duplicate column 'pos'", lineno);
+                if (t != 'r' || count != 3)
+                    return odhs__err(msg, ODHS_E_FORMAT,
+                                     "line %zu: Properties: 'pos' must be R:3", lineno);
+                have_pos = 1;
+                h->col_pos = col;
+            } else if (span_ieq(name, "radius")) {
+                if (have_rad)
+                    return odhs__err(msg, ODHS_E_FORMAT,
+                                     "line %zu: Properties: duplicate column 'radius'", lineno);
+                if (t != 'r' || count != 1)
+                    return odhs__err(msg, ODHS_E_FORMAT,
+                                     "line %zu: Properties: 'radius' must be R:1", lineno);
+                have_rad = 1;
+                h->col_rad = col;
+            }
+            col += count;
+            break;
+        }
+        }
+        field++;
+        if (last) break;
+        i++; /* skip ':' */
+    }
+    if (field % 3 != 0)
+        return odhs__err(msg, ODHS_E_FORMAT,
+                         "line %zu: Properties: expected name:type:count triplets", lineno);
+    if (!have_sp || !have_pos || !have_rad)
+        return odhs__err(msg, ODHS_E_FORMAT,
+                         "line %zu: Properties must contain species:S:1, pos:R:3 and "
+                         "radius:R:1 (missing %s)",
+                         lineno, !have_sp ? "species" : !have_pos ? "pos" : "radius");
+    h->ncols = col;
+    return ODHS_OK;
+}
+
+enum { K_LATTICE, K_PROPERTIES, K_PBC, K_DIM, K_STRAIN, K_COUNT };
+static const char *const key_names[K_COUNT] = {"Lattice", "Properties", "pbc", "dim", "strain"};
+
+static int parse_header(span line, size_t lineno, header *h, char *msg)
+{
+    span val[K_COUNT];
+    int have[K_COUNT] = {0};
+    size_t i = 0;
+
+    /* 1. split into key[=value] items */
+    for (;;) {
+        while (i < line.n && is_ws(line.p[i])) i++;
+        if (i >= line.n) break;
+        size_t start = i;
+        while (i < line.n && !is_ws(line.p[i]) && line.p[i] != '=') i++;
+        span key = {line.p + start, i - start};
+        if (key.n == 0)
+            return odhs__err(msg, ODHS_E_FORMAT, "line %zu: '=' without a key", lineno);
+        size_t j = i;
+        while (j < line.n && is_ws(line.p[j])) j++;
+        span v = {line.p + i, 0};
+        int has_value = 0;
+        if (j < line.n && line.p[j] == '=') {
+            has_value = 1;
+            i = j + 1;
+            while (i < line.n && is_ws(line.p[i])) i++;
+            if (i < line.n && (line.p[i] == '"' || line.p[i] == '{' || line.p[i] == '[')) {
+                char close = line.p[i] == '"' ? '"' : line.p[i] == '{' ? '}' : ']';
+                i++;
+                size_t vs = i;
+                while (i < line.n && line.p[i] != close) {
+                    if (close == '"' && line.p[i] == '\\' && i + 1 < line.n)
+                        i += 2;
+                    else
+                        i++;
+                }
+                if (i >= line.n)
+                    return odhs__err(msg, ODHS_E_FORMAT,
+                                     "line %zu: unterminated value of key '%.*s'", lineno,
+                                     show_len(key), key.p);
+                v.p = line.p + vs;
+                v.n = i - vs;
+                i++; /* closing character */
+            } else {
+                size_t vs = i;
+                while (i < line.n && !is_ws(line.p[i])) i++;
+                v.p = line.p + vs;
+                v.n = i - vs;
+            }
+        }
+        for (int k = 0; k < K_COUNT; k++) {
+            if (!span_ieq(key, key_names[k])) continue;
+            if (!has_value)
+                return odhs__err(msg, ODHS_E_FORMAT, "line %zu: key '%s' has no value", lineno,
+                                 key_names[k]);
+            if (have[k])
+                return odhs__err(msg, ODHS_E_FORMAT, "line %zu: duplicate key '%s'", lineno,
+                                 key_names[k]);
+            have[k] = 1;
+            val[k] = v;
+        }
+        /* any other key (with or without value) is ignored */
+    }
+
+    /* 2. interpret */
+    if (!have[K_LATTICE])
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: missing Lattice key", lineno);
+    if (!have[K_PROPERTIES])
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: missing Properties key", lineno);
+
+    int st = parse_properties(val[K_PROPERTIES], lineno, h, msg);
+    if (st < 0) return st;
+
+    int dim = 3;
+    if (have[K_PBC]) {
+        int flags[3] = {1, 1, 1};
+        size_t k = 0, nf = 0;
+        span t;
+        while (next_token(val[K_PBC], &k, &t)) {
+            if (nf >= 3 || parse_flag(t, &flags[nf]) != 0)
+                return odhs__err(msg, ODHS_E_FORMAT,
+                                 "line %zu: pbc must be three flags T or F, got \"%.*s\"", lineno,
+                                 show_len(val[K_PBC]), val[K_PBC].p);
+            nf++;
+        }
+        if (nf != 3)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: pbc must be three flags T or F, got \"%.*s\"", lineno,
+                             show_len(val[K_PBC]), val[K_PBC].p);
+        if (!flags[2]) dim = 2;
+    }
+    if (have[K_DIM]) {
+        span d = trim(val[K_DIM]);
+        if (span_ieq(d, "2"))
+            dim = 2;
+        else if (span_ieq(d, "3"))
+            dim = 3;
+        else
+            return odhs__err(msg, ODHS_E_FORMAT, "line %zu: dim must be 2 or 3, got '%.*s'",
+                             lineno, show_len(d), d.p);
+    }
+    h->dim = dim;
+
+    double lat[9];
+    span bad = {NULL, 0};
+    int nonfinite = 0;
+    long cnt = parse_number_list(val[K_LATTICE], lat, 9, &bad, &nonfinite);
+    if (cnt < 0)
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: Lattice: %s '%.*s'", lineno,
+                         nonfinite ? "non-finite number" : "invalid number", show_len(bad),
+                         bad.p);
+    if (cnt != 9)
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: Lattice: expected 9 numbers, found %ld",
+                         lineno, cnt);
+    double Lx = lat[0], bx = lat[3], Ly = lat[4], Lz = lat[8];
+    double scale = fabs(Lx) + fabs(Ly) + fabs(Lz);
+    double tol = 1e-12 * scale;
+    int ok = Lx > 0.0 && Ly > 0.0 && fabs(lat[1]) <= tol && fabs(lat[2]) <= tol &&
+             fabs(lat[5]) <= tol && fabs(lat[6]) <= tol && fabs(lat[7]) <= tol &&
+             (dim == 2 ? Lz >= 0.0 : Lz > 0.0);
+    if (!ok)
+        return odhs__err(msg, ODHS_E_FORMAT,
+                         "line %zu: Lattice: only orthogonal cells with x-y shear supported "
+                         "(need a=(Lx,0,0), b=(bx,Ly,0), c=(0,0,Lz) with Lx, Ly, Lz > 0)",
+                         lineno);
+    h->L[0] = Lx;
+    h->L[1] = Ly;
+    h->L[2] = dim == 3 ? Lz : 1.0;
+
+    if (have[K_STRAIN]) {
+        double g = 0.0;
+        span s = trim(val[K_STRAIN]);
+        int rc = parse_double(s, &g);
+        if (rc != 0)
+            return odhs__err(msg, ODHS_E_FORMAT, "line %zu: strain: %s '%.*s'", lineno,
+                             rc == -2 ? "non-finite number" : "invalid number", show_len(s), s.p);
+        if (!(fabs(bx - g * Ly) <= 1e-9 * Ly))
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: strain=%.17g disagrees with the Lattice "
+                             "(bx = %.17g, expected strain*Ly = %.17g)",
+                             lineno, g, bx, g * Ly);
+        h->gamma = g;
+    } else {
+        h->gamma = bx / Ly;
+        if (!isfinite(h->gamma))
+            return odhs__err(msg, ODHS_E_FORMAT, "line %zu: Lattice: strain bx/Ly not finite",
+                             lineno);
+    }
+    return ODHS_OK;
+}
+
+/* ---- particle lines --------------------------------------------------------- */
+
+static int parse_particle(span line, size_t lineno, const header *h, double *x, double *r,
+                          char *label, char *msg)
+{
+    size_t ncol = count_tokens(line);
+    if (ncol != h->ncols)
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: expected %zu columns, found %zu", lineno,
+                         h->ncols, ncol);
+    size_t i = 0, c = 0;
+    span tok;
+    while (next_token(line, &i, &tok)) {
+        double *dst = NULL;
+        const char *what = NULL;
+        double zdummy = 0.0;
+        if (c == h->col_sp) {
+            if (!valid_label(tok))
+                return odhs__err(msg, ODHS_E_FORMAT,
+                                 "line %zu: invalid species label '%.*s' (1..%d printable "
+                                 "characters, no white space or quotes)",
+                                 lineno, show_len(tok), tok.p, ODHS_SPECIES_MAX);
+            memcpy(label, tok.p, tok.n);
+            label[tok.n] = '\0';
+        } else if (c >= h->col_pos && c < h->col_pos + 3) {
+            size_t k = c - h->col_pos;
+            what = "pos";
+            dst = (k < (size_t)h->dim) ? &x[k] : &zdummy;
+        } else if (c == h->col_rad) {
+            what = "radius";
+            dst = r;
+        }
+        if (dst) {
+            int rc = parse_double(tok, dst);
+            if (rc != 0)
+                return odhs__err(msg, ODHS_E_FORMAT, "line %zu: column %zu (%s): %s '%.*s'",
+                                 lineno, c + 1, what,
+                                 rc == -2 ? "non-finite number" : "invalid number",
+                                 show_len(tok), tok.p);
+        }
+        c++;
+    }
+    if (!(*r > 0.0))
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: radius must be positive, got %.17g",
+                         lineno, *r);
+    return ODHS_OK;
+}
+
+/* Whether a line holds just a positive integer (the start of another frame). */
+static int is_frame_start(span line)
+{
+    span t = trim(line);
+    size_t v = 0;
+    return parse_count(t, XYZ_N_MAX, &v) == 0 && v > 0;
+}
+
+static int is_blank(span line)
+{
+    return trim(line).n == 0;
+}
+
+static int parse_impl(const char *buf, size_t len, odhs_system **out, char *msg)
+{
+    reader rd = {buf, len, 0, 0};
+    span line;
+
+    /* line 1: N */
+    if (!next_line(&rd, &line))
+        return odhs__err(msg, ODHS_E_FORMAT, "line 1: empty file");
+    span t = trim(line);
+    size_t n = 0;
+    int rc = parse_count(t, XYZ_N_MAX, &n);
+    if (rc == -2)
+        return odhs__err(msg, ODHS_E_FORMAT,
+                         "line 1: number of particles too large (at most %zu)", XYZ_N_MAX);
+    if (rc != 0 || n == 0)
+        return odhs__err(msg, ODHS_E_FORMAT,
+                         "line 1: expected the number of particles (a positive integer), "
+                         "found '%.*s'",
+                         show_len(t), t.p);
+
+    /* line 2: key=value pairs */
+    if (!next_line(&rd, &line))
+        return odhs__err(msg, ODHS_E_FORMAT, "line 2: file ends before the comment line");
+    header h;
+    memset(&h, 0, sizeof h);
+    int st = parse_header(line, rd.lineno, &h, msg);
+    if (st < 0) return st;
+
+    /* pass 1: make sure the N lines exist before allocating anything */
+    reader body = rd;
+    for (size_t i = 0; i < n; i++) {
+        if (!next_line(&rd, &line))
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: file ends after %zu of %zu particle lines", rd.lineno + 1,
+                             i, n);
+    }
+
+    /* pass 2: parse into temporary arrays */
+    int dim = h.dim;
+    double *x = odhs__malloc_array(n, (size_t)dim * sizeof(double));
+    double *r = odhs__malloc_array(n, sizeof(double));
+    char(*sp)[ODHS_SPECIES_MAX + 1] = odhs__malloc_array(n, sizeof *sp);
+    odhs_system *sys = NULL;
+    if (!x || !r || !sp) {
+        st = odhs__err(msg, ODHS_E_NOMEM, "out of memory reading %zu particles", n);
+        goto done;
+    }
+    rd = body;
+    for (size_t i = 0; i < n; i++) {
+        if (!next_line(&rd, &line)) { /* cannot happen after pass 1 */
+            st = odhs__err(msg, ODHS_E_INTERNAL, "line %zu: unexpected end of input",
+                           rd.lineno + 1);
+            goto done;
+        }
+        st = parse_particle(line, rd.lineno, &h, &x[i * (size_t)dim], &r[i], sp[i], msg);
+        if (st < 0) goto done;
+    }
+    /* first frame only: skip blank lines, accept (and ignore) a following
+     * frame, reject anything else (usually a wrong N) */
+    while (next_line(&rd, &line)) {
+        if (is_blank(line)) continue;
+        if (!is_frame_start(line)) {
+            st = odhs__err(msg, ODHS_E_FORMAT,
+                           "line %zu: unexpected content after %zu particle lines "
+                           "(is the particle count on line 1 right?)",
+                           rd.lineno, n);
+            goto done;
+        }
+        break;
+    }
+
+    /* build and validate the system */
+    st = odhs_system_create(dim, n, &sys);
+    if (st < 0) {
+        sys = NULL;
+        odhs__err(msg, st, "cannot create system: %s", odhs_strerror(st));
+        goto done;
+    }
+    st = odhs_system_set_configuration(sys, h.L, h.gamma, r, x);
+    if (st < 0) {
+        odhs__err(msg, st, "file: %s", odhs_system_errmsg(sys));
+        goto done;
+    }
+    for (size_t i = 0; i < n; i++) {
+        st = odhs_system_set_species(sys, i, sp[i]);
+        if (st < 0) {
+            odhs__err(msg, ODHS_E_FORMAT, "line %zu: species '%s': %s", i + 3, sp[i],
+                      odhs_system_errmsg(sys));
+            st = ODHS_E_FORMAT;
+            goto done;
+        }
+    }
+    st = ODHS_OK;
+    *out = sys;
+    sys = NULL;
+
+done:
+    odhs_system_destroy(sys);
+    odhs__free(x);
+    odhs__free(r);
+    odhs__free(sp);
+    return st;
+}
+
+static void copy_msg(char *errbuf, size_t errlen, const char *msg)
+{
+    if (errbuf && errlen > 0) snprintf(errbuf, errlen, "%s", msg);
+}
+
+int odhs_xyz_parse(const char *buf, size_t len, odhs_system **out, char *errbuf, size_t errlen)
+{
+    char msg[ODHS_ERRMSG_LEN];
+    msg[0] = '\0';
+    if (errbuf && errlen > 0) errbuf[0] = '\0';
+    if (out) *out = NULL;
+    if (!out || !buf) {
+        int st = odhs__err(msg, ODHS_E_NULL, "%s is NULL", !out ? "out" : "buf");
+        copy_msg(errbuf, errlen, msg);
+        return st;
+    }
+    int st = parse_impl(buf, len, out, msg);
+    if (st < 0) {
+        *out = NULL;
+        copy_msg(errbuf, errlen, msg);
+    }
+    return st;
+}
+
+int odhs_xyz_read(const char *path, odhs_system **out, char *errbuf, size_t errlen)
+{
+    char msg[ODHS_ERRMSG_LEN];
+    msg[0] = '\0';
+    if (errbuf && errlen > 0) errbuf[0] = '\0';
+    if (out) *out = NULL;
+    if (!out || !path) {
+        int st = odhs__err(msg, ODHS_E_NULL, "%s is NULL", !out ? "out" : "path");
+        copy_msg(errbuf, errlen, msg);
+        return st;
+    }
+    errno = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        int e = errno;
+        int st = odhs__err(msg, ODHS_E_IO, "cannot open '%s': %s", path,
+                           e ? strerror(e) : "unknown error");
+        copy_msg(errbuf, errlen, msg);
+        return st;
+    }
+    size_t cap = 65536, len = 0;
+    char *data = odhs__malloc(cap);
+    if (!data) {
+        fclose(f);
+        int st = odhs__err(msg, ODHS_E_NOMEM, "out of memory reading '%s'", path);
+        copy_msg(errbuf, errlen, msg);
+        return st;
+    }
+    for (;;) {
+        if (len == cap) {
+            if (cap > ((size_t)-1) / 2) {
+                fclose(f);
+                odhs__free(data);
+                int st = odhs__err(msg, ODHS_E_NOMEM, "'%s' is too large", path);
+                copy_msg(errbuf, errlen, msg);
+                return st;
+            }
+            char *bigger = odhs__realloc(data, cap * 2);
+            if (!bigger) {
+                fclose(f);
+                odhs__free(data);
+                int st = odhs__err(msg, ODHS_E_NOMEM, "out of memory reading '%s'", path);
+                copy_msg(errbuf, errlen, msg);
+                return st;
+            }
+            data = bigger;
+            cap *= 2;
+        }
+        errno = 0;
+        size_t got = fread(data + len, 1, cap - len, f);
+        len += got;
+        if (got == 0) break;
+    }
+    if (ferror(f)) {
+        int e = errno;
+        fclose(f);
+        odhs__free(data);
+        int st = odhs__err(msg, ODHS_E_IO, "cannot read '%s': %s", path,
+                           e ? strerror(e) : "read error");
+        copy_msg(errbuf, errlen, msg);
+        return st;
+    }
+    fclose(f);
+    int st = odhs_xyz_parse(data, len, out, errbuf, errlen);
+    odhs__free(data);
+    return st;
+}
+
+/* ---- writer ------------------------------------------------------------------ */
+
+/* Makes temporary names unique within the process ("wx" below refuses to
+ * open an existing file anyway, so a collision only costs a retry). */
+#if defined(__STDC_NO_ATOMICS__)
+static unsigned long tmp_counter;
+#else
+static _Atomic unsigned long tmp_counter;
+#endif
+
+static int write_body(FILE *f, const odhs_system *sys, int dim, size_t n, const double *L,
+                      double gamma, const double *x, const double *r)
+{
+    double Lz = dim == 3 ? L[2] : 1.0;
+    if (fprintf(f, "%zu\n", n) < 0) return -1;
+    if (fprintf(f,
+                "Lattice=\"%.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\" "
+                "Properties=species:S:1:pos:R:3:radius:R:1 pbc=\"%s\" dim=%d strain=%.17g\n",
+                L[0], 0.0, 0.0, gamma * L[1], L[1], 0.0, 0.0, 0.0, Lz,
+                dim == 3 ? "T T T" : "T T F", dim, gamma) < 0)
+        return -1;
+    char label[ODHS_SPECIES_MAX + 1];
+    for (size_t i = 0; i < n; i++) {
+        if (odhs_system_get_species(sys, i, label, sizeof label) < 0) return -2;
+        const double *xi = &x[i * (size_t)dim];
+        if (fprintf(f, "%s %.17g %.17g %.17g %.17g\n", label, xi[0], xi[1],
+                    dim == 3 ? xi[2] : 0.0, r[i]) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+int odhs_xyz_write(const odhs_system *sys, const char *path)
+{
+    if (!sys) return ODHS_E_NULL;
+    if (!path) return odhs__syserr(sys, ODHS_E_NULL, "path is NULL");
+    if (!odhs_system_is_ready(sys))
+        return odhs__syserr(sys, ODHS_E_STATE, "radii or positions not set");
+
+    int dim = odhs_system_dim(sys);
+    size_t n = odhs_system_count(sys);
+    double L[3] = {1.0, 1.0, 1.0}, gamma = 0.0;
+    int st = odhs_system_get_box(sys, L);
+    if (st < 0) return st;
+    st = odhs_system_get_strain(sys, &gamma);
+    if (st < 0) return st;
+
+    double *x = odhs__malloc_array(n, (size_t)dim * sizeof(double));
+    double *r = odhs__malloc_array(n, sizeof(double));
+    size_t plen = strlen(path);
+    char *tmp = (plen < ((size_t)-1) - 64) ? odhs__malloc(plen + 64) : NULL;
+    FILE *f = NULL;
+    if (!x || !r || !tmp) {
+        st = odhs__syserr(sys, ODHS_E_NOMEM, "out of memory writing '%s'", path);
+        goto done;
+    }
+    if ((st = odhs_system_get_positions(sys, x)) < 0 || (st = odhs_system_get_radii(sys, r)) < 0)
+        goto done;
+
+    /* unique temporary name in the same directory, then rename() over path */
+    for (int attempt = 0;; attempt++) {
+        unsigned long k = tmp_counter++;
+        snprintf(tmp, plen + 64, "%s.tmp.%ld.%lu", path, (long)getpid(), k);
+        errno = 0;
+        f = fopen(tmp, "wx");
+        if (f || errno != EEXIST || attempt >= 100) break;
+    }
+    if (!f) {
+        int e = errno;
+        st = odhs__syserr(sys, ODHS_E_IO, "cannot write '%s': %s", path,
+                          e ? strerror(e) : "cannot create temporary file");
+        goto done;
+    }
+    errno = 0;
+    int wr = write_body(f, sys, dim, n, L, gamma, x, r);
+    int e = errno;
+    if (wr == 0 && fflush(f) != 0) {
+        wr = -1;
+        e = errno;
+    }
+    if (wr == 0 && ferror(f)) wr = -1;
+    int cl = fclose(f);
+    if (wr == 0 && cl != 0) {
+        wr = -1;
+        e = errno;
+    }
+    f = NULL;
+    if (wr != 0) {
+        remove(tmp);
+        st = odhs__syserr(sys, wr == -2 ? ODHS_E_INTERNAL : ODHS_E_IO,
+                          "cannot write '%s': %s", path,
+                          wr == -2 ? "species lookup failed" : e ? strerror(e) : "write error");
+        goto done;
+    }
+    errno = 0;
+    if (rename(tmp, path) != 0) {
+        e = errno;
+        remove(tmp);
+        st = odhs__syserr(sys, ODHS_E_IO, "cannot rename '%s' to '%s': %s", tmp, path,
+                          e ? strerror(e) : "rename failed");
+        goto done;
+    }
+    st = ODHS_OK;
+
+done:
+    odhs__free(x);
+    odhs__free(r);
+    odhs__free(tmp);
+    return st;
+}

@@ -1,0 +1,522 @@
+/* libodhs - contact network, the operator S and the constrained subset. */
+#include <math.h>
+#include <string.h>
+
+#include "internal.h"
+
+int odhs__neterr(const odhs_network *net, int status, const char *fmt, ...)
+{
+    if (!net) return status;
+    va_list ap;
+    va_start(ap, fmt);
+    odhs__verr(((odhs_network *)net)->errmsg, status, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+static inline uint64_t pair_key(const odhs_network *net, size_t i, size_t j)
+{
+    return (uint64_t)i * (uint64_t)net->n + (uint64_t)j + 1u;
+}
+
+static inline size_t hash_slot(uint64_t key, size_t mask)
+{
+    key ^= key >> 33;
+    key *= 0xff51afd7ed558ccdULL;
+    key ^= key >> 33;
+    return (size_t)key & mask;
+}
+
+static int hash_resize(odhs_network *net, size_t hcap)
+{
+    uint64_t *k = odhs__calloc(hcap, sizeof *k);
+    size_t *v = odhs__malloc_array(hcap, sizeof *v);
+    if (!k || !v) {
+        odhs__free(k);
+        odhs__free(v);
+        return ODHS_E_NOMEM;
+    }
+    size_t mask = hcap - 1;
+    for (size_t c = 0; c < net->nc; ++c) {
+        uint64_t key = pair_key(net, net->ci[c], net->cj[c]);
+        size_t s = hash_slot(key, mask);
+        while (k[s]) s = (s + 1) & mask;
+        k[s] = key;
+        v[s] = c;
+    }
+    odhs__free(net->hkey);
+    odhs__free(net->hval);
+    net->hkey = k;
+    net->hval = v;
+    net->hcap = hcap;
+    return ODHS_OK;
+}
+
+static int grow(odhs_network *net)
+{
+    size_t cap = net->cap ? 2 * net->cap : 64;
+    int d = net->dim;
+    size_t *ci = odhs__realloc(net->ci, cap * sizeof *ci);
+    if (ci) net->ci = ci;
+    size_t *cj = odhs__realloc(net->cj, cap * sizeof *cj);
+    if (cj) net->cj = cj;
+    int *kind = odhs__realloc(net->kind, cap * sizeof *kind);
+    if (kind) net->kind = kind;
+    double *nrm = odhs__realloc(net->nrm, cap * d * sizeof *nrm);
+    if (nrm) net->nrm = nrm;
+    double *dist = odhs__realloc(net->dist, cap * sizeof *dist);
+    if (dist) net->dist = dist;
+    double *gap = odhs__realloc(net->gap, cap * sizeof *gap);
+    if (gap) net->gap = gap;
+    double *f = odhs__realloc(net->f, cap * sizeof *f);
+    if (f) net->f = f;
+    if (!ci || !cj || !kind || !nrm || !dist || !gap || !f) return ODHS_E_NOMEM;
+    net->cap = cap;
+    if (net->hcap < 2 * cap) return hash_resize(net, 4 * cap);
+    return ODHS_OK;
+}
+
+int odhs_network_create(const odhs_system *sys, odhs_network **out)
+{
+    if (!out) return ODHS_E_NULL;
+    *out = NULL;
+    if (!sys) return ODHS_E_NULL;
+    odhs_network *net = odhs__calloc(1, sizeof *net);
+    if (!net) return ODHS_E_NOMEM;
+    net->dim = sys->dim;
+    net->n = sys->n;
+    if (grow(net)) {
+        odhs_network_destroy(net);
+        return ODHS_E_NOMEM;
+    }
+    *out = net;
+    return ODHS_OK;
+}
+
+void odhs_network_destroy(odhs_network *net)
+{
+    if (!net) return;
+    odhs__free(net->ci);
+    odhs__free(net->cj);
+    odhs__free(net->kind);
+    odhs__free(net->nrm);
+    odhs__free(net->dist);
+    odhs__free(net->gap);
+    odhs__free(net->f);
+    odhs__free(net->hkey);
+    odhs__free(net->hval);
+    odhs__free(net);
+}
+
+const char *odhs_network_errmsg(const odhs_network *net) { return net ? net->errmsg : ""; }
+size_t odhs_network_count(const odhs_network *net) { return net ? net->nc : 0; }
+size_t odhs_network_particles(const odhs_network *net) { return net ? net->n : 0; }
+int odhs_network_dim(const odhs_network *net) { return net ? net->dim : 0; }
+
+size_t odhs__net_find(const odhs_network *net, size_t i, size_t j)
+{
+    if (i > j) {
+        size_t t = i;
+        i = j;
+        j = t;
+    }
+    uint64_t key = pair_key(net, i, j);
+    size_t mask = net->hcap - 1, s = hash_slot(key, mask);
+    while (net->hkey[s]) {
+        if (net->hkey[s] == key) return net->hval[s];
+        s = (s + 1) & mask;
+    }
+    return SIZE_MAX;
+}
+
+size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
+{
+    if (i > j) {
+        size_t t = i;
+        i = j;
+        j = t;
+    }
+    if (net->nc == net->cap && grow(net)) return SIZE_MAX;
+    size_t c = net->nc++;
+    net->ci[c] = i;
+    net->cj[c] = j;
+    net->kind[c] = kind;
+    for (int k = 0; k < net->dim; ++k) net->nrm[c * net->dim + k] = 0.0;
+    net->dist[c] = net->gap[c] = net->f[c] = 0.0;
+    uint64_t key = pair_key(net, i, j);
+    size_t mask = net->hcap - 1, s = hash_slot(key, mask);
+    while (net->hkey[s]) s = (s + 1) & mask;
+    net->hkey[s] = key;
+    net->hval[s] = c;
+    net->version++;
+    return c;
+}
+
+/* delete key from the linear-probing table (backward-shift deletion) */
+static void hash_delete(odhs_network *net, uint64_t key)
+{
+    size_t mask = net->hcap - 1, s = hash_slot(key, mask);
+    while (net->hkey[s] != key) s = (s + 1) & mask;
+    size_t hole = s;
+    for (;;) {
+        s = (s + 1) & mask;
+        if (!net->hkey[s]) break;
+        size_t home = hash_slot(net->hkey[s], mask);
+        /* can the entry at s move into the hole? (home not in (hole, s]) */
+        int move = (hole <= s) ? (home <= hole || home > s) : (home <= hole && home > s);
+        if (move) {
+            net->hkey[hole] = net->hkey[s];
+            net->hval[hole] = net->hval[s];
+            hole = s;
+        }
+    }
+    net->hkey[hole] = 0;
+}
+
+static void hash_set(odhs_network *net, uint64_t key, size_t val)
+{
+    size_t mask = net->hcap - 1, s = hash_slot(key, mask);
+    while (net->hkey[s] != key) s = (s + 1) & mask;
+    net->hval[s] = val;
+}
+
+void odhs__net_remove_at(odhs_network *net, size_t k)
+{
+    hash_delete(net, pair_key(net, net->ci[k], net->cj[k]));
+    size_t last = net->nc - 1;
+    if (k != last) {
+        int d = net->dim;
+        net->ci[k] = net->ci[last];
+        net->cj[k] = net->cj[last];
+        net->kind[k] = net->kind[last];
+        memcpy(net->nrm + k * d, net->nrm + last * d, (size_t)d * sizeof(double));
+        net->dist[k] = net->dist[last];
+        net->gap[k] = net->gap[last];
+        net->f[k] = net->f[last];
+        hash_set(net, pair_key(net, net->ci[k], net->cj[k]), k);
+    }
+    net->nc--;
+    net->version++;
+}
+
+int odhs_network_add(odhs_network *net, size_t i, size_t j, int kind)
+{
+    if (!net) return ODHS_E_NULL;
+    if (i >= net->n || j >= net->n)
+        return odhs__neterr(net, ODHS_E_RANGE, "particle index out of range (N = %zu)", net->n);
+    if (i == j) return odhs__neterr(net, ODHS_E_INVALID, "a contact needs two different particles");
+    if (kind != ODHS_CONTACT_TEMPORARY && kind != ODHS_CONTACT_PERMANENT)
+        return odhs__neterr(net, ODHS_E_INVALID, "unknown contact kind %d", kind);
+    if (odhs__net_find(net, i, j) != SIZE_MAX)
+        return odhs__neterr(net, ODHS_E_INVALID, "contact (%zu,%zu) already present", i, j);
+    if (odhs__net_add(net, i, j, kind) == SIZE_MAX) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    return ODHS_OK;
+}
+
+int odhs_network_remove(odhs_network *net, size_t i, size_t j)
+{
+    if (!net) return ODHS_E_NULL;
+    if (i >= net->n || j >= net->n)
+        return odhs__neterr(net, ODHS_E_RANGE, "particle index out of range (N = %zu)", net->n);
+    size_t k = odhs__net_find(net, i, j);
+    if (k == SIZE_MAX) return odhs__neterr(net, ODHS_E_INVALID, "no contact (%zu,%zu)", i, j);
+    odhs__net_remove_at(net, k);
+    return ODHS_OK;
+}
+
+int odhs_network_clear(odhs_network *net)
+{
+    if (!net) return ODHS_E_NULL;
+    while (net->nc) odhs__net_remove_at(net, net->nc - 1);
+    return ODHS_OK;
+}
+
+int odhs_network_find(const odhs_network *net, size_t i, size_t j, size_t *index)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!index) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    if (i >= net->n || j >= net->n)
+        return odhs__neterr(net, ODHS_E_RANGE, "particle index out of range (N = %zu)", net->n);
+    *index = odhs__net_find(net, i, j);
+    return ODHS_OK;
+}
+
+void odhs__net_geometry(odhs_network *net, const odhs_system *sys)
+{
+    int d = net->dim;
+    for (size_t c = 0; c < net->nc; ++c) {
+        size_t i = net->ci[c], j = net->cj[c];
+        double v[3] = {0, 0, 0};
+        for (int k = 0; k < d; ++k) v[k] = sys->x[j * d + k] - sys->x[i * d + k];
+        odhs__min_image(d, sys->L, sys->gamma, v, NULL);
+        double r = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        net->dist[c] = r;
+        net->gap[c] = r - (sys->r[i] + sys->r[j]);
+        for (int k = 0; k < d; ++k) net->nrm[c * d + k] = v[k] / r;
+    }
+    net->version++;
+}
+
+static int check_sys(const odhs_network *net, const odhs_system *sys)
+{
+    if (!sys) return odhs__neterr(net, ODHS_E_NULL, "system is NULL");
+    if (sys->n != net->n || sys->dim != net->dim)
+        return odhs__neterr(net, ODHS_E_DIM, "system does not match the network (N or dimension)");
+    if (!sys->has_x || !sys->has_r)
+        return odhs__neterr(net, ODHS_E_STATE, "system radii and positions must be set");
+    return ODHS_OK;
+}
+
+int odhs_network_update_geometry(odhs_network *net, const odhs_system *sys)
+{
+    if (!net) return ODHS_E_NULL;
+    int st = check_sys(net, sys);
+    if (st) return st;
+    odhs__net_geometry(net, sys);
+    return ODHS_OK;
+}
+
+typedef struct {
+    odhs_network *net;
+    const double *r;
+    double tol;
+    int status;
+} detect_ctx;
+
+static int detect_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    detect_ctx *c = vctx;
+    if (gap <= c->tol * (c->r[i] + c->r[j]) && odhs__net_find(c->net, i, j) == SIZE_MAX) {
+        if (odhs__net_add(c->net, i, j, ODHS_CONTACT_TEMPORARY) == SIZE_MAX) {
+            c->status = ODHS_E_NOMEM;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int odhs_network_detect(odhs_network *net, const odhs_system *sys, double tol)
+{
+    if (!net) return ODHS_E_NULL;
+    int st = check_sys(net, sys);
+    if (st) return st;
+    if (!isfinite(tol) || tol < 0.0) return odhs__neterr(net, ODHS_E_INVALID, "tolerance must be >= 0");
+    detect_ctx c = {net, sys->r, tol, ODHS_OK};
+    st = odhs__pairs(sys->dim, sys->n, sys->x, sys->r, sys->rmax, sys->L, sys->gamma,
+                     tol * 2.0 * sys->rmax, detect_cb, &c);
+    if (st == ODHS_E_NOMEM || c.status) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    odhs__net_geometry(net, sys);
+    return ODHS_OK;
+}
+
+int odhs_network_get_contact(const odhs_network *net, size_t k, size_t *i, size_t *j, int *kind)
+{
+    if (!net) return ODHS_E_NULL;
+    if (k >= net->nc) return odhs__neterr(net, ODHS_E_RANGE, "contact index %zu >= Nc = %zu", k, net->nc);
+    if (i) *i = net->ci[k];
+    if (j) *j = net->cj[k];
+    if (kind) *kind = net->kind[k];
+    return ODHS_OK;
+}
+
+static int copy_out(const odhs_network *net, const double *src, double *dst, size_t count)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!dst) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    if (count) memcpy(dst, src, count * sizeof(double));
+    return ODHS_OK;
+}
+
+int odhs_network_get_forces(const odhs_network *net, double *f)
+{
+    return copy_out(net, net ? net->f : NULL, f, net ? net->nc : 0);
+}
+int odhs_network_get_gaps(const odhs_network *net, double *gap)
+{
+    return copy_out(net, net ? net->gap : NULL, gap, net ? net->nc : 0);
+}
+int odhs_network_get_normals(const odhs_network *net, double *n)
+{
+    return copy_out(net, net ? net->nrm : NULL, n, net ? net->nc * (size_t)net->dim : 0);
+}
+
+int odhs_network_set_forces(odhs_network *net, const double *f)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!f && net->nc) return odhs__neterr(net, ODHS_E_NULL, "forces pointer is NULL");
+    for (size_t c = 0; c < net->nc; ++c)
+        if (!isfinite(f[c])) return odhs__neterr(net, ODHS_E_NONFINITE, "force %zu is not finite", c);
+    if (net->nc) memcpy(net->f, f, net->nc * sizeof(double));
+    return ODHS_OK;
+}
+
+/* ---- S, S^T, N -------------------------------------------------------------- */
+void odhs__net_S(const odhs_network *net, const double *v, double *out)
+{
+    const int d = net->dim;
+    for (size_t c = 0; c < net->nc; ++c) {
+        const double *n = net->nrm + c * d;
+        const double *vi = v + net->ci[c] * d, *vj = v + net->cj[c] * d;
+        double s = 0.0;
+        for (int k = 0; k < d; ++k) s += (vj[k] - vi[k]) * n[k];
+        out[c] = s;
+    }
+}
+
+void odhs__net_ST(const odhs_network *net, const double *f, double *out)
+{
+    const int d = net->dim;
+    memset(out, 0, net->n * (size_t)d * sizeof(double));
+    for (size_t c = 0; c < net->nc; ++c) {
+        const double *n = net->nrm + c * d;
+        double *oi = out + net->ci[c] * d, *oj = out + net->cj[c] * d;
+        for (int k = 0; k < d; ++k) {
+            oi[k] -= f[c] * n[k];
+            oj[k] += f[c] * n[k];
+        }
+    }
+}
+
+void odhs__net_N(const odhs_network *net, const double *x, double *out, double *work)
+{
+    odhs__net_ST(net, x, work);
+    odhs__net_S(net, work, out);
+}
+
+int odhs_network_apply_S(const odhs_network *net, const double *v, double *out)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!v || !out) return odhs__neterr(net, ODHS_E_NULL, "vector pointer is NULL");
+    odhs__net_S(net, v, out);
+    return ODHS_OK;
+}
+
+int odhs_network_apply_ST(const odhs_network *net, const double *f, double *out)
+{
+    if (!net) return ODHS_E_NULL;
+    if ((!f && net->nc) || !out) return odhs__neterr(net, ODHS_E_NULL, "vector pointer is NULL");
+    odhs__net_ST(net, f, out);
+    return ODHS_OK;
+}
+
+int odhs_network_apply_N(const odhs_network *net, const double *x, double *out, double *work)
+{
+    if (!net) return ODHS_E_NULL;
+    if ((!x || !out) && net->nc) return odhs__neterr(net, ODHS_E_NULL, "vector pointer is NULL");
+    double *w = work;
+    if (!w) {
+        w = odhs__malloc_array(net->n * (size_t)net->dim, sizeof(double));
+        if (!w) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    }
+    odhs__net_N(net, x, out, w);
+    if (!work) odhs__free(w);
+    return ODHS_OK;
+}
+
+size_t odhs_network_nnz(const odhs_network *net) { return net ? net->nc * 2u * (size_t)net->dim : 0; }
+
+int odhs_network_get_S_csr(const odhs_network *net, size_t *rowptr, size_t *col, double *val)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!rowptr || ((!col || !val) && net->nc)) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    const int d = net->dim;
+    size_t p = 0;
+    rowptr[0] = 0;
+    for (size_t c = 0; c < net->nc; ++c) {
+        size_t a = net->ci[c], b = net->cj[c]; /* a < b: columns in increasing order */
+        for (int k = 0; k < d; ++k) {
+            col[p] = a * d + k;
+            val[p++] = -net->nrm[c * d + k];
+        }
+        for (int k = 0; k < d; ++k) {
+            col[p] = b * d + k;
+            val[p++] = net->nrm[c * d + k];
+        }
+        rowptr[c + 1] = p;
+    }
+    return ODHS_OK;
+}
+
+int odhs_network_coordination(const odhs_network *net, double *z)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!z) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    *z = 2.0 * (double)net->nc / (double)net->n;
+    return ODHS_OK;
+}
+
+int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon,
+                             unsigned char *in_subset, long *zbar_num)
+{
+    if (!net) return ODHS_E_NULL;
+    size_t n = net->n, nc = net->nc;
+    size_t *deg = odhs__calloc(n, sizeof *deg);
+    size_t *start = odhs__calloc(n + 1, sizeof *start);
+    size_t *adj = odhs__malloc_array(2 * nc, sizeof *adj);
+    size_t *queue = odhs__malloc_array(n, sizeof *queue);
+    unsigned char *alive = odhs__malloc_array(n, 1);
+    if (!deg || !start || !adj || !queue || !alive) {
+        odhs__free(deg);
+        odhs__free(start);
+        odhs__free(adj);
+        odhs__free(queue);
+        odhs__free(alive);
+        return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    }
+    for (size_t c = 0; c < nc; ++c) {
+        deg[net->ci[c]]++;
+        deg[net->cj[c]]++;
+    }
+    for (size_t i = 0; i < n; ++i) start[i + 1] = start[i] + deg[i];
+    {
+        size_t *fill = queue; /* reuse as fill pointers */
+        for (size_t i = 0; i < n; ++i) fill[i] = start[i];
+        for (size_t c = 0; c < nc; ++c) {
+            adj[fill[net->ci[c]]++] = net->cj[c];
+            adj[fill[net->cj[c]]++] = net->ci[c];
+        }
+    }
+    size_t need = (size_t)net->dim + 1, qh = 0, qt = 0;
+    for (size_t i = 0; i < n; ++i) {
+        alive[i] = 1;
+        if (deg[i] < need) {
+            alive[i] = 0;
+            queue[qt++] = i;
+        }
+    }
+    while (qh < qt) {
+        size_t i = queue[qh++];
+        for (size_t p = start[i]; p < start[i + 1]; ++p) {
+            size_t j = adj[p];
+            if (alive[j] && --deg[j] < need) {
+                alive[j] = 0;
+                queue[qt++] = j;
+            }
+        }
+    }
+    size_t nb = 0, cc = 0;
+    for (size_t i = 0; i < n; ++i) nb += alive[i];
+    for (size_t c = 0; c < nc; ++c) cc += alive[net->ci[c]] && alive[net->cj[c]];
+    if (nbar) *nbar = nb;
+    if (ncon) *ncon = cc;
+    if (zbar_num) *zbar_num = nb ? 2L * (net->dim - 1) + 2L * (long)cc : 0;
+    if (in_subset) memcpy(in_subset, alive, n);
+    odhs__free(deg);
+    odhs__free(start);
+    odhs__free(adj);
+    odhs__free(queue);
+    odhs__free(alive);
+    return ODHS_OK;
+}
+
+int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!flag) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    size_t nb, cc;
+    int st = odhs_network_constrained(net, &nb, &cc, NULL, NULL);
+    if (st) return st;
+    *flag = nb > 0 && cc >= (size_t)net->dim * (nb - 1) + 1;
+    return ODHS_OK;
+}

@@ -1,0 +1,149 @@
+/* libodhs - solver handle: wraps a backend table, checks every result. */
+#include <math.h>
+#include <string.h>
+
+#include "internal.h"
+
+static int solerr(const odhs_solver *s, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
+static int solerr(const odhs_solver *s, int status, const char *fmt, ...)
+{
+    if (!s) return status;
+    va_list ap;
+    va_start(ap, fmt);
+    odhs__verr(((odhs_solver *)s)->errmsg, status, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out)
+{
+    if (!out) return ODHS_E_NULL;
+    *out = NULL;
+    if (!type) return ODHS_E_NULL;
+    if (type->version < 1 || type->version > ODHS_SOLVER_TYPE_VERSION || !type->name || !type->create ||
+        !type->destroy || !type->solve)
+        return ODHS_E_INVALID;
+    odhs_solver *s = odhs__calloc(1, sizeof *s);
+    if (!s) return ODHS_E_NOMEM;
+    s->type = type;
+    s->check_tol = 1e-6;
+    int st = type->create(&s->state);
+    if (st) {
+        odhs__free(s);
+        return st < 0 ? st : ODHS_E_INTERNAL;
+    }
+    *out = s;
+    return ODHS_OK;
+}
+
+int odhs_solver_create_by_name(const char *name, odhs_solver **out)
+{
+    if (!out) return ODHS_E_NULL;
+    *out = NULL;
+    if (!name) return ODHS_E_NULL;
+    if (!strcmp(name, "cg")) return odhs_solver_create(&odhs_solver_type_cg, out);
+    if (!strcmp(name, "dense")) return odhs_solver_create(&odhs_solver_type_dense, out);
+    if (!strcmp(name, "cholmod") || !strcmp(name, "spqr") || !strcmp(name, "auto"))
+        return ODHS_E_NOTINSTALLED;
+    return ODHS_E_INVALID;
+}
+
+void odhs_solver_destroy(odhs_solver *s)
+{
+    if (!s) return;
+    s->type->destroy(s->state);
+    odhs__free(s->work);
+    odhs__free(s);
+}
+
+const char *odhs_solver_errmsg(const odhs_solver *s) { return s ? s->errmsg : ""; }
+const char *odhs_solver_name(const odhs_solver *s) { return s ? s->type->name : ""; }
+
+int odhs_solver_set_param(odhs_solver *s, const char *key, double value)
+{
+    if (!s) return ODHS_E_NULL;
+    if (!key) return solerr(s, ODHS_E_NULL, "parameter name is NULL");
+    if (!isfinite(value)) return solerr(s, ODHS_E_NONFINITE, "parameter %s is not finite", key);
+    if (!s->type->set_param) return solerr(s, ODHS_E_INVALID, "backend %s has no parameters", s->type->name);
+    int st = s->type->set_param(s->state, key, value);
+    if (st) return solerr(s, st, "backend %s rejected parameter %s = %g", s->type->name, key, value);
+    return ODHS_OK;
+}
+
+int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value)
+{
+    if (!s) return ODHS_E_NULL;
+    if (!key || !value) return solerr(s, ODHS_E_NULL, "NULL argument");
+    if (!strcmp(key, "residual")) {
+        *value = s->last_residual;
+        return ODHS_OK;
+    }
+    if (!strcmp(key, "solves")) {
+        *value = s->nsolves;
+        return ODHS_OK;
+    }
+    if (s->type->get_stat && s->type->get_stat(s->state, key, value) == ODHS_OK) return ODHS_OK;
+    return solerr(s, ODHS_E_INVALID, "unknown statistic %s", key);
+}
+
+int odhs_solver_set_check_tolerance(odhs_solver *s, double tol)
+{
+    if (!s) return ODHS_E_NULL;
+    if (!isfinite(tol) || !(tol > 0.0)) return solerr(s, ODHS_E_INVALID, "check tolerance must be > 0");
+    s->check_tol = tol;
+    return ODHS_OK;
+}
+
+int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x)
+{
+    if (!s) return ODHS_E_NULL;
+    if (!net) return solerr(s, ODHS_E_NULL, "network is NULL");
+    size_t nc = net->nc;
+    if (nc == 0) return ODHS_OK;
+    if (!b || !x) return solerr(s, ODHS_E_NULL, "vector pointer is NULL");
+    for (size_t c = 0; c < nc; ++c)
+        if (!isfinite(b[c])) return solerr(s, ODHS_E_NONFINITE, "right-hand side entry %zu is not finite", c);
+    size_t need = nc + net->n * (size_t)net->dim;
+    if (s->work_cap < need) {
+        double *w = odhs__realloc(s->work, need * sizeof *w);
+        if (!w) return solerr(s, ODHS_E_NOMEM, "out of memory");
+        s->work = w;
+        s->work_cap = need;
+    }
+    int st;
+    if (s->type->setup && (!s->have_setup || s->last_net != net || s->last_version != net->version)) {
+        st = s->type->setup(s->state, net);
+        if (st) {
+            s->have_setup = 0;
+            return solerr(s, st < 0 ? st : ODHS_E_INTERNAL, "%s: setup failed (%s)", s->type->name,
+                          odhs_strerror(st));
+        }
+        s->have_setup = 1;
+        s->last_net = net;
+        s->last_version = net->version;
+    }
+    if (!(s->type->flags & ODHS_SOLVER_USES_GUESS)) memset(x, 0, nc * sizeof *x);
+    st = s->type->solve(s->state, net, b, x);
+    s->nsolves += 1.0;
+    if (st < 0) return solerr(s, st, "%s: solve failed (%s)", s->type->name, odhs_strerror(st));
+    /* check the result: finite, small residual */
+    double *Nx = s->work, *tmp = s->work + nc;
+    for (size_t c = 0; c < nc; ++c)
+        if (!isfinite(x[c]))
+            return solerr(s, ODHS_E_SINGULAR, "%s: solution is not finite (singular network?)",
+                          s->type->name);
+    odhs__net_N(net, x, Nx, tmp);
+    double rn = 0.0, bn = 0.0;
+    for (size_t c = 0; c < nc; ++c) {
+        double r = Nx[c] - b[c];
+        rn += r * r;
+        bn += b[c] * b[c];
+    }
+    s->last_residual = bn > 0.0 ? sqrt(rn / bn) : sqrt(rn);
+    if (s->last_residual > s->check_tol) {
+        int code = (s->type->flags & ODHS_SOLVER_ITERATIVE) ? ODHS_E_NOCONV : ODHS_E_SINGULAR;
+        return solerr(s, code, "%s: relative residual %.3g above %.3g", s->type->name, s->last_residual,
+                      s->check_tol);
+    }
+    return ODHS_OK;
+}

@@ -1,0 +1,1085 @@
+/* libodhs - the event-driven stepper (Sect. IV of Lerner, During & Wyart 2013).
+ *
+ * State between steps: a valid contact network (all temporary contacts carry
+ * f >= 0, removed pairs separate), its forces, and the non-affine velocities
+ * U = V - V_aff = xi0 (F_ext + S^T f). A step moves every particle on a straight
+ * line, x += tau (G x + U), and deforms the box with the same G, so every pair
+ * separation is linear in time and collision times are exact roots of a
+ * quadratic. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+#define EPS_F 1e-12 /* relative threshold for negative forces   */
+#define EPS_V 1e-12 /* relative threshold for approaching pairs */
+
+static int sterr(const odhs_stepper *st, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
+static int sterr(const odhs_stepper *st, int status, const char *fmt, ...)
+{
+    if (!st) return status;
+    va_list ap;
+    va_start(ap, fmt);
+    odhs__verr(((odhs_stepper *)st)->errmsg, status, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+/* ---- small helpers ------------------------------------------------------ */
+static int reserve(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (*cap >= need) return ODHS_OK;
+    size_t c = *cap ? *cap : 16;
+    while (c < need) c *= 2;
+    void *q = odhs__realloc(*p, c * elem);
+    if (!q) return ODHS_E_NOMEM;
+    *p = q;
+    *cap = c;
+    return ODHS_OK;
+}
+
+static int reserve_contacts(odhs_stepper *st, size_t nc)
+{
+    if (st->ccap >= nc) return ODHS_OK;
+    size_t c = st->ccap ? st->ccap : 64;
+    while (c < nc) c *= 2;
+    double *b = odhs__realloc(st->cb, c * sizeof *b);
+    if (b) st->cb = b;
+    double *x = odhs__realloc(st->cx, c * sizeof *x);
+    if (x) st->cx = x;
+    if (!b || !x) return ODHS_E_NOMEM;
+    st->ccap = c;
+    return ODHS_OK;
+}
+
+static void min_sep(const odhs_stepper *st, size_t i, size_t j, double *d)
+{
+    const odhs_system *s = st->sys;
+    int dim = st->dim;
+    d[0] = d[1] = d[2] = 0.0;
+    for (int k = 0; k < dim; ++k) d[k] = s->x[j * dim + k] - s->x[i * dim + k];
+    odhs__min_image(dim, s->L, s->gamma, d, NULL);
+}
+
+/* G d (affine relative velocity of a separation d) */
+static inline void apply_G(const double *G, int dim, const double *d, double *out)
+{
+    for (int a = 0; a < dim; ++a) {
+        double s = 0.0;
+        for (int b = 0; b < dim; ++b) s += G[3 * (a) + (b)] * d[b];
+        out[a] = s;
+    }
+}
+
+static void set_gradient(odhs_stepper *st, double c_eff)
+{
+    memset(st->G, 0, sizeof st->G);
+    st->G[3 * (0) + (1)] = st->drv->gdot;
+    for (int a = 0; a < st->dim; ++a) st->G[3 * (a) + (a)] = -c_eff;
+}
+
+static int record_change(odhs_stepper *st, size_t i, size_t j, int delta)
+{
+    if (reserve((void **)&st->chg, &st->chgcap, st->nchg + 1, sizeof *st->chg)) return ODHS_E_NOMEM;
+    st->chg[st->nchg].i = i < j ? i : j;
+    st->chg[st->nchg].j = i < j ? j : i;
+    st->chg[st->nchg].delta = delta;
+    st->nchg++;
+    return ODHS_OK;
+}
+
+/* ---- external forces ---------------------------------------------------- */
+static int eval_forces(odhs_stepper *st)
+{
+    odhs_driver *d = st->drv;
+    if (d->fn) {
+        memset(st->F, 0, st->nd * sizeof *st->F);
+        if (d->fn(st->time, st->sys, st->F, d->fn_ctx))
+            return sterr(st, ODHS_E_CALLBACK, "force callback failed at t = %.17g", st->time);
+        for (size_t k = 0; k < st->nd; ++k)
+            if (!isfinite(st->F[k]))
+                return sterr(st, ODHS_E_CALLBACK, "force callback returned a non-finite value for particle %zu",
+                             k / st->dim);
+        st->has_F = 1;
+    } else if (d->F) {
+        if (d->Fn != st->n || d->Fdim != st->dim)
+            return sterr(st, ODHS_E_DIM, "driver forces are for N = %zu, d = %d", d->Fn, d->Fdim);
+        memcpy(st->F, d->F, st->nd * sizeof *st->F);
+        st->has_F = 1;
+    } else {
+        st->has_F = 0;
+    }
+    return ODHS_OK;
+}
+
+/* ---- forces and velocities on the current network ---------------------- */
+static int solve(odhs_stepper *st, const double *b, double *x)
+{
+    int s = odhs_solver_solve(st->sol, st->net, b, x);
+    if (s) return sterr(st, s, "force solve: %s", odhs_solver_errmsg(st->sol));
+    return ODHS_OK;
+}
+
+/* Solve for the contact forces (into net->f) and kappa under pressure control. */
+static int compute_forces(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    odhs_driver *drv = st->drv;
+    size_t nc = net->nc;
+    int dim = st->dim, s;
+    double xi0 = drv->xi0;
+    if ((s = reserve_contacts(st, nc))) return sterr(st, s, "out of memory");
+    if (!drv->pressure_on) {
+        set_gradient(st, drv->crate);
+        st->kappa = drv->gdot != 0.0 ? drv->crate / drv->gdot : drv->crate;
+    }
+    if (nc == 0) {
+        if (drv->pressure_on) {
+            st->kappa = drv->kappa_max * (drv->gdot > 0 ? 1.0 : -1.0);
+            set_gradient(st, drv->gdot * st->kappa);
+        }
+        return ODHS_OK;
+    }
+    /* b = -S (V_aff + xi0 F) / xi0, with the pressure part of V_aff left out */
+    double G0[9];
+    memcpy(G0, st->G, sizeof G0);
+    if (drv->pressure_on) {
+        memset(G0, 0, sizeof G0);
+        G0[3 * (0) + (1)] = drv->gdot;
+    }
+    double *b = st->cb;
+    for (size_t c = 0; c < nc; ++c) {
+        const double *n = net->nrm + c * dim;
+        double d[3] = {0, 0, 0}, gd[3];
+        for (int k = 0; k < dim; ++k) d[k] = n[k] * net->dist[c];
+        apply_G(G0, dim, d, gd);
+        double v = 0.0;
+        for (int k = 0; k < dim; ++k) v += gd[k] * n[k];
+        if (st->has_F) {
+            const double *Fi = st->F + net->ci[c] * dim, *Fj = st->F + net->cj[c] * dim;
+            for (int k = 0; k < dim; ++k) v += xi0 * (Fj[k] - Fi[k]) * n[k];
+        }
+        b[c] = -v / xi0;
+    }
+    if (!drv->pressure_on) return solve(st, b, net->f);
+
+    /* fixed pressure: f = x2 + (gdot kappa / xi0) x1 with N x2 = b, N x1 = r */
+    double *x1 = st->cx;
+    if ((s = solve(st, b, net->f))) return s;
+    memset(x1, 0, nc * sizeof *x1);
+    if ((s = solve(st, net->dist, x1))) return s;
+    double rx1 = 0.0, rx2 = 0.0, vol;
+    for (size_t c = 0; c < nc; ++c) {
+        rx1 += net->dist[c] * x1[c];
+        rx2 += net->dist[c] * net->f[c];
+    }
+    odhs_system_volume(st->sys, &vol);
+    double kappa;
+    double gd = drv->gdot;
+    if (rx1 > 0.0) kappa = xi0 * (drv->p * vol * dim - rx2) / (gd * rx1);
+    else kappa = drv->kappa_max * (gd > 0 ? 1.0 : -1.0);
+    if (!isfinite(kappa) || kappa > drv->kappa_max) kappa = drv->kappa_max;
+    if (kappa < -drv->kappa_max) kappa = -drv->kappa_max;
+    st->kappa = kappa;
+    double a = gd * kappa / xi0;
+    for (size_t c = 0; c < nc; ++c) net->f[c] += a * x1[c];
+    set_gradient(st, gd * kappa);
+    return ODHS_OK;
+}
+
+static void compute_velocities(odhs_stepper *st)
+{
+    double xi0 = st->drv->xi0;
+    odhs__net_ST(st->net, st->net->f, st->U);
+    for (size_t k = 0; k < st->nd; ++k) st->U[k] = xi0 * (st->U[k] + (st->has_F ? st->F[k] : 0.0));
+}
+
+static double velocity_scale(const odhs_stepper *st)
+{
+    double umax = 0.0, g = 0.0;
+    for (size_t k = 0; k < st->nd; ++k) umax = fmax(umax, fabs(st->U[k]));
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) g += st->G[3 * (a) + (b)] * st->G[3 * (a) + (b)];
+    return umax + sqrt(g) * 2.0 * st->sys->rmax;
+}
+
+/* relative normal velocity of a pair that is not (necessarily) a contact */
+static double pair_velocity(const odhs_stepper *st, size_t i, size_t j)
+{
+    int dim = st->dim;
+    double d[3], gd[3];
+    min_sep(st, i, j, d);
+    apply_G(st->G, dim, d, gd);
+    double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), v = 0.0;
+    for (int k = 0; k < dim; ++k) v += (gd[k] + st->U[j * dim + k] - st->U[i * dim + k]) * d[k];
+    return v / r;
+}
+
+static void contact_geometry(odhs_stepper *st, size_t c)
+{
+    odhs_network *net = st->net;
+    int dim = st->dim;
+    double d[3];
+    min_sep(st, net->ci[c], net->cj[c], d);
+    double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    net->dist[c] = r;
+    net->gap[c] = r - (st->sys->r[net->ci[c]] + st->sys->r[net->cj[c]]);
+    for (int k = 0; k < dim; ++k) net->nrm[c * dim + k] = d[k] / r;
+    net->version++;
+}
+
+/* Rewiring (Sect. IV B): remove the most negative force until none is left,
+ * then re-connect the most approaching removed pair, and repeat. */
+static int rewire(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    int s;
+    st->nrem = 0;
+    size_t maxit = 4 * (net->nc + 16) + 200, it = 0;
+    for (;;) {
+        if (++it > maxit)
+            return sterr(st, ODHS_E_REWIRE, "rewiring did not terminate after %zu iterations", maxit);
+        if ((s = compute_forces(st))) return s;
+        double fmax = 0.0, fmin = 0.0;
+        size_t kmin = SIZE_MAX;
+        for (size_t c = 0; c < net->nc; ++c) {
+            fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
+            if (net->kind[c] == ODHS_CONTACT_TEMPORARY && net->f[c] < fmin) {
+                fmin = net->f[c];
+                kmin = c;
+            }
+        }
+        if (kmin != SIZE_MAX && fmin < -EPS_F * fmax) {
+            size_t i = net->ci[kmin], j = net->cj[kmin];
+            if (reserve((void **)&st->rem, &st->remcap, st->nrem + 1, sizeof *st->rem))
+                return sterr(st, ODHS_E_NOMEM, "out of memory");
+            st->rem[st->nrem].i = i;
+            st->rem[st->nrem].j = j;
+            st->nrem++;
+            odhs__net_remove_at(net, kmin);
+            if (record_change(st, i, j, -1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
+            continue;
+        }
+        compute_velocities(st);
+        if (st->nrem == 0) break;
+        double vs = velocity_scale(st), vmin = 0.0;
+        size_t rmin = SIZE_MAX;
+        for (size_t q = 0; q < st->nrem; ++q) {
+            double v = pair_velocity(st, st->rem[q].i, st->rem[q].j);
+            if (v < vmin) {
+                vmin = v;
+                rmin = q;
+            }
+        }
+        if (rmin == SIZE_MAX || vmin >= -EPS_V * vs) break;
+        size_t i = st->rem[rmin].i, j = st->rem[rmin].j;
+        st->rem[rmin] = st->rem[st->nrem - 1];
+        st->nrem--;
+        size_t c = odhs__net_add(net, i, j, ODHS_CONTACT_TEMPORARY);
+        if (c == SIZE_MAX || record_change(st, i, j, +1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
+        contact_geometry(st, c);
+    }
+    return ODHS_OK;
+}
+
+/* ---- neighbour list ----------------------------------------------------- */
+typedef struct {
+    odhs_stepper *st;
+    int status;
+} nb_ctx;
+
+static int nb_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    (void)gap;
+    nb_ctx *c = vctx;
+    odhs_stepper *st = c->st;
+    if (st->npairs == st->pcap) {
+        size_t cap = st->pcap ? 2 * st->pcap : 1024;
+        size_t *a = odhs__realloc(st->pi, cap * sizeof *a);
+        if (a) st->pi = a;
+        size_t *b = odhs__realloc(st->pj, cap * sizeof *b);
+        if (b) st->pj = b;
+        if (!a || !b) {
+            c->status = ODHS_E_NOMEM;
+            return 1;
+        }
+        st->pcap = cap;
+    }
+    st->pi[st->npairs] = i;
+    st->pj[st->npairs] = j;
+    st->npairs++;
+    return 0;
+}
+
+static int build_neighbours(odhs_stepper *st)
+{
+    odhs_system *s = st->sys;
+    double Lmin = fmin(s->L[0], s->L[1]);
+    if (st->dim == 3) Lmin = fmin(Lmin, s->L[2]);
+    double rmean = 0.0;
+    for (size_t i = 0; i < st->n; ++i) rmean += s->r[i];
+    rmean /= (double)st->n;
+    double skin = 0.5 * rmean;
+    double room = 0.5 * Lmin - 2.0 * s->rmax; /* pair range must stay below L/2 */
+    if (skin > 0.9 * room) skin = 0.9 * room;
+    if (!(skin > 1e-3 * rmean))
+        return sterr(st, ODHS_E_BOX,
+                     "box too small for the neighbour search: shortest edge %.6g, largest diameter %.6g",
+                     Lmin, 2.0 * s->rmax);
+    st->skin = skin;
+    st->rc = 2.0 * s->rmax + skin;
+    st->npairs = 0;
+    nb_ctx c = {st, ODHS_OK};
+    int r = odhs__pairs(st->dim, st->n, s->x, s->r, s->rmax, s->L, s->gamma, skin, nb_cb, &c);
+    if (r == ODHS_E_NOMEM || c.status) return sterr(st, ODHS_E_NOMEM, "out of memory");
+    memset(st->disp, 0, st->nd * sizeof *st->disp);
+    memset(st->M, 0, sizeof st->M);
+    for (int a = 0; a < 3; ++a) st->M[3 * (a) + (a)] = 1.0;
+    return ODHS_OK;
+}
+
+static double frob(const double *A)
+{
+    double s = 0.0;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) s += A[3 * (a) + (b)] * A[3 * (a) + (b)];
+    return sqrt(s);
+}
+
+/* bound on how much any pair separation changed since the list was built */
+static double skin_used(const odhs_stepper *st)
+{
+    double dmax = 0.0;
+    int dim = st->dim;
+    for (size_t i = 0; i < st->n; ++i) {
+        double s = 0.0;
+        for (int k = 0; k < dim; ++k) s += st->disp[i * dim + k] * st->disp[i * dim + k];
+        dmax = fmax(dmax, s);
+    }
+    double MI[9];
+    memcpy(MI, st->M, sizeof MI);
+    for (int a = 0; a < 3; ++a) MI[3 * (a) + (a)] -= 1.0;
+    return 2.0 * sqrt(dmax) + frob(MI) * st->rc;
+}
+
+/* rate at which skin_used can grow while moving with velocity field (G, vel) */
+static double skin_rate(const odhs_stepper *st, const double *G, const double *vel)
+{
+    double umax = 0.0;
+    int dim = st->dim;
+    for (size_t i = 0; i < st->n; ++i) {
+        double s = 0.0;
+        for (int k = 0; k < dim; ++k) s += vel[i * dim + k] * vel[i * dim + k];
+        umax = fmax(umax, s);
+    }
+    return 2.0 * sqrt(umax) + frob(G) * frob(st->M) * st->rc;
+}
+
+/* ---- collision prediction ------------------------------------------------ */
+/* earliest time in [0, horizon] at which a non-contact pair touches when
+ * separations move as d + t (G d + vel_j - vel_i) */
+static double predict(const odhs_stepper *st, const double *G, const double *vel, double horizon,
+                      double vtol, size_t *pi, size_t *pj)
+{
+    const odhs_system *s = st->sys;
+    int dim = st->dim;
+    double best = horizon;
+    *pi = *pj = SIZE_MAX;
+    for (size_t p = 0; p < st->npairs; ++p) {
+        size_t i = st->pi[p], j = st->pj[p];
+        double d[3], gd[3] = {0, 0, 0}, w[3] = {0, 0, 0};
+        min_sep(st, i, j, d);
+        apply_G(G, dim, d, gd);
+        double a = 0.0, b = 0.0, dd = 0.0;
+        for (int k = 0; k < dim; ++k) {
+            w[k] = gd[k] + vel[j * dim + k] - vel[i * dim + k];
+            a += w[k] * w[k];
+            b += d[k] * w[k];
+            dd += d[k] * d[k];
+        }
+        if (b >= 0.0) continue; /* not approaching */
+        double sig = s->r[i] + s->r[j];
+        double c = dd - sig * sig;
+        /* quick reject: cannot close the gap within the current best time */
+        double gap = sqrt(dd) - sig;
+        if (gap > 0.0 && gap > best * sqrt(a)) continue;
+        if (odhs__net_find(st->net, i, j) != SIZE_MAX) continue;
+        double t;
+        if (c <= 0.0) {
+            /* touching (round-off): a collision now if really approaching */
+            if (-b <= vtol * sqrt(dd)) continue;
+            t = 0.0;
+        } else {
+            double disc = b * b - a * c;
+            if (disc < 0.0) continue;
+            t = c / (-b + sqrt(disc));
+        }
+        if (t < best) {
+            best = t;
+            *pi = i;
+            *pj = j;
+        }
+    }
+    return best;
+}
+
+/* move by t along (G, vel), deforming the box with G */
+static void advance(odhs_stepper *st, const double *G, const double *vel, double t)
+{
+    odhs_system *s = st->sys;
+    int dim = st->dim;
+    for (size_t i = 0; i < st->n; ++i) {
+        double *x = s->x + i * dim, gx[3];
+        apply_G(G, dim, x, gx);
+        for (int k = 0; k < dim; ++k) {
+            double dx = t * vel[i * dim + k];
+            x[k] += t * gx[k] + dx;
+            st->disp[i * dim + k] += dx;
+        }
+    }
+    /* box: H' = (I + tG) H with G = gdot e_x e_y^T - c I */
+    double scale = 1.0 + t * G[3 * (1) + (1)];
+    double g = s->gamma + t * G[3 * (0) + (1)] / scale;
+    for (int k = 0; k < dim; ++k) s->L[k] *= scale;
+    g -= nearbyint(g);
+    s->gamma = g;
+    double Mn[9];
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+            double v = st->M[3 * (a) + (b)];
+            for (int c = 0; c < 3; ++c) v += t * G[3 * (a) + (c)] * st->M[3 * (c) + (b)];
+            Mn[3 * (a) + (b)] = v;
+        }
+    memcpy(st->M, Mn, sizeof Mn);
+    for (size_t i = 0; i < st->n; ++i) odhs__wrap(dim, s->L, s->gamma, s->x + i * dim);
+}
+
+/* ---- snapshot / rollback ------------------------------------------------- */
+static int snapshot(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    if (st->scap < net->nc) {
+        size_t cap = net->cap;
+        size_t *a = odhs__realloc(st->sci, cap * sizeof *a);
+        if (a) st->sci = a;
+        size_t *b = odhs__realloc(st->scj, cap * sizeof *b);
+        if (b) st->scj = b;
+        int *k = odhs__realloc(st->skind, cap * sizeof *k);
+        if (k) st->skind = k;
+        double *f = odhs__realloc(st->sf, cap * sizeof *f);
+        if (f) st->sf = f;
+        if (!a || !b || !k || !f) return sterr(st, ODHS_E_NOMEM, "out of memory");
+        st->scap = cap;
+    }
+    memcpy(st->xs, st->sys->x, st->nd * sizeof *st->xs);
+    memcpy(st->Ls, st->sys->L, sizeof st->Ls);
+    st->gammas = st->sys->gamma;
+    st->times = st->time;
+    st->strains = st->strain;
+    st->snc = net->nc;
+    memcpy(st->Gs, st->G, sizeof st->Gs);
+    st->kappas = st->kappa;
+    memcpy(st->sci, net->ci, net->nc * sizeof *st->sci);
+    memcpy(st->scj, net->cj, net->nc * sizeof *st->scj);
+    memcpy(st->skind, net->kind, net->nc * sizeof *st->skind);
+    memcpy(st->sf, net->f, net->nc * sizeof *st->sf);
+    return ODHS_OK;
+}
+
+static void rollback(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    memcpy(st->sys->x, st->xs, st->nd * sizeof *st->xs);
+    memcpy(st->sys->L, st->Ls, sizeof st->Ls);
+    st->sys->gamma = st->gammas;
+    st->time = st->times;
+    st->strain = st->strains;
+    odhs_network_clear(net);
+    for (size_t c = 0; c < st->snc; ++c) {
+        size_t k = odhs__net_add(net, st->sci[c], st->scj[c], st->skind[c]);
+        if (k == SIZE_MAX) break; /* cannot happen: capacity is retained */
+        net->f[k] = st->sf[c];
+    }
+    odhs__net_geometry(net, st->sys);
+    memcpy(st->G, st->Gs, sizeof st->G);
+    st->kappa = st->kappas;
+    /* velocities from the restored forces */
+    if (eval_forces(st) == ODHS_OK) compute_velocities(st);
+    st->nb_stale = 1; /* rebuild the neighbour list before the next step */
+}
+
+/* ---- lifecycle ------------------------------------------------------------- */
+int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver, odhs_stepper **out)
+{
+    if (!out) return ODHS_E_NULL;
+    *out = NULL;
+    if (!sys || !drv || !solver) return ODHS_E_NULL;
+    if (!sys->has_r || !sys->has_x) return odhs__syserr(sys, ODHS_E_STATE, "set radii and positions first");
+    odhs_stepper *st = odhs__calloc(1, sizeof *st);
+    if (!st) return ODHS_E_NOMEM;
+    st->sys = sys;
+    st->drv = drv;
+    st->sol = solver;
+    st->dim = sys->dim;
+    st->n = sys->n;
+    st->nd = sys->n * (size_t)sys->dim;
+    st->dt = 1e-3;
+    st->corr_every = 10;
+    st->contact_tol = 1e-9;
+    st->F = odhs__calloc(st->nd, sizeof(double));
+    st->U = odhs__calloc(st->nd, sizeof(double));
+    st->tmp = odhs__calloc(st->nd, sizeof(double));
+    st->disp = odhs__calloc(st->nd, sizeof(double));
+    st->xs = odhs__calloc(st->nd, sizeof(double));
+    int s = odhs_network_create(sys, &st->net);
+    if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || s) {
+        odhs_stepper_destroy(st);
+        return ODHS_E_NOMEM;
+    }
+    *out = st;
+    return ODHS_OK;
+}
+
+void odhs_stepper_destroy(odhs_stepper *st)
+{
+    if (!st) return;
+    odhs_network_destroy(st->net);
+    void *arrays[] = {st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
+                      st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->ev};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
+    odhs__free(st);
+}
+
+const char *odhs_stepper_errmsg(const odhs_stepper *st) { return st ? st->errmsg : ""; }
+
+int odhs_stepper_set_dt(odhs_stepper *st, double dt)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(dt)) return sterr(st, ODHS_E_NONFINITE, "dt is not finite");
+    if (!(dt > 0.0)) return sterr(st, ODHS_E_INVALID, "dt = %g must be > 0", dt);
+    st->dt = dt;
+    return ODHS_OK;
+}
+
+int odhs_stepper_set_correction_interval(odhs_stepper *st, unsigned k)
+{
+    if (!st) return ODHS_E_NULL;
+    st->corr_every = k;
+    return ODHS_OK;
+}
+
+int odhs_stepper_set_contact_tolerance(odhs_stepper *st, double tol)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(tol) || tol < 0.0 || tol > 0.1)
+        return sterr(st, ODHS_E_INVALID, "contact tolerance %g must be in [0, 0.1]", tol);
+    st->contact_tol = tol;
+    return ODHS_OK;
+}
+
+int odhs_stepper_set_event_callback(odhs_stepper *st, odhs_event_fn fn, void *ctx)
+{
+    if (!st) return ODHS_E_NULL;
+    st->evfn = fn;
+    st->evctx = ctx;
+    return ODHS_OK;
+}
+
+static int check_driver(odhs_stepper *st)
+{
+    odhs_driver *d = st->drv;
+    if (d->pressure_on && d->gdot == 0.0)
+        return sterr(st, ODHS_E_UNSUPPORTED, "fixed pressure needs a nonzero shear rate");
+    if (d->pressure_on && d->crate != 0.0)
+        return sterr(st, ODHS_E_UNSUPPORTED, "fixed pressure and a compression rate cannot be combined");
+    if (d->F && (d->Fn != st->n || d->Fdim != st->dim))
+        return sterr(st, ODHS_E_DIM, "driver forces are for N = %zu, d = %d, the system has N = %zu, d = %d",
+                     d->Fn, d->Fdim, st->n, st->dim);
+    return ODHS_OK;
+}
+
+static int check_jammed(odhs_stepper *st)
+{
+    int flag = 0;
+    int s = odhs_network_potentially_jammed(st->net, &flag);
+    if (s) return sterr(st, s, "%s", odhs_network_errmsg(st->net));
+    st->jammed = flag;
+    return ODHS_OK;
+}
+
+int odhs_stepper_reset(odhs_stepper *st)
+{
+    if (!st) return ODHS_E_NULL;
+    int s;
+    st->ready = 0;
+    st->jammed = 0;
+    if ((s = check_driver(st))) return s;
+    if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) return sterr(st, s, "%s", st->drv->errmsg);
+    /* keep permanent contacts, rebuild the temporary ones */
+    odhs_network *net = st->net;
+    odhs__net_geometry(net, st->sys);
+    for (size_t c = net->nc; c-- > 0;) {
+        double sig = st->sys->r[net->ci[c]] + st->sys->r[net->cj[c]];
+        if (net->kind[c] == ODHS_CONTACT_TEMPORARY && fabs(net->gap[c]) > fmax(1e-6, st->contact_tol) * sig)
+            odhs__net_remove_at(net, c);
+    }
+    if ((s = odhs_network_detect(net, st->sys, st->contact_tol))) return sterr(st, s, "%s", net->errmsg);
+    if ((s = build_neighbours(st))) return s;
+    if ((s = eval_forces(st))) return s;
+    if ((s = check_jammed(st))) return s;
+    if (st->jammed) return sterr(st, ODHS_POTENTIALLY_JAMMED, "the initial network is potentially jammed");
+    st->nchg = 0;
+    if ((s = rewire(st))) return s;
+    st->nchg = 0;
+    st->drv_version = st->drv->version;
+    st->ready = 1;
+    return ODHS_OK;
+}
+
+/* ---- drift correction (Sect. IV C) ------------------------------------- */
+static int correct(odhs_stepper *st, int *added)
+{
+    odhs_network *net = st->net;
+    int s;
+    double Z[9] = {0};
+    for (int pass = 0; pass < 50; ++pass) {
+        size_t nc = net->nc;
+        if (nc == 0) return ODHS_OK;
+        odhs__net_geometry(net, st->sys);
+        if ((s = reserve_contacts(st, nc))) return sterr(st, s, "out of memory");
+        double gmax = 0.0;
+        for (size_t c = 0; c < nc; ++c) gmax = fmax(gmax, fabs(net->gap[c]));
+        if (gmax == 0.0) return ODHS_OK;
+        memset(st->cx, 0, nc * sizeof *st->cx);
+        if ((s = solve(st, net->gap, st->cx))) return s;
+        odhs__net_ST(net, st->cx, st->tmp);
+        for (size_t k = 0; k < st->nd; ++k) st->tmp[k] = -st->tmp[k];
+        size_t pi, pj;
+        double t = predict(st, Z, st->tmp, 1.0, 0.0, &pi, &pj);
+        advance(st, Z, st->tmp, t);
+        if (pi == SIZE_MAX) {
+            odhs__net_geometry(net, st->sys);
+            return ODHS_OK;
+        }
+        size_t c = odhs__net_add(net, pi, pj, ODHS_CONTACT_TEMPORARY);
+        if (c == SIZE_MAX || record_change(st, pi, pj, +1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
+        *added = 1;
+        if ((s = check_jammed(st))) return s;
+        if (st->jammed) return ODHS_OK;
+    }
+    odhs__net_geometry(net, st->sys);
+    return ODHS_OK;
+}
+
+/* ---- events ------------------------------------------------------------------ */
+static int cmp_change(const void *a, const void *b)
+{
+    const odhs_change *x = a, *y = b;
+    if (x->i != y->i) return x->i < y->i ? -1 : 1;
+    if (x->j != y->j) return x->j < y->j ? -1 : 1;
+    return 0;
+}
+
+/* turn the step's recorded changes into net events */
+static int collect_events(odhs_stepper *st)
+{
+    st->nev = 0;
+    if (st->nchg == 0) return ODHS_OK;
+    qsort(st->chg, st->nchg, sizeof *st->chg, cmp_change);
+    for (size_t a = 0; a < st->nchg;) {
+        size_t b = a;
+        int sum = 0;
+        while (b < st->nchg && st->chg[b].i == st->chg[a].i && st->chg[b].j == st->chg[a].j) sum += st->chg[b++].delta;
+        if (sum != 0) {
+            if (reserve((void **)&st->ev, &st->evcap, st->nev + 1, sizeof *st->ev))
+                return sterr(st, ODHS_E_NOMEM, "out of memory");
+            odhs_event *e = &st->ev[st->nev++];
+            e->kind = sum > 0 ? ODHS_EVENT_COLLISION : ODHS_EVENT_OPENING;
+            e->i = st->chg[a].i;
+            e->j = st->chg[a].j;
+            e->time = st->time;
+            e->strain = st->strain;
+        }
+        a = b;
+    }
+    st->nchg = 0;
+    return ODHS_OK;
+}
+
+static int emit_events(odhs_stepper *st, odhs_event *first, int *stop);
+
+/* ---- one step ----------------------------------------------------------------- */
+/* limit: largest time to advance (INFINITY for none); *stop set by callbacks */
+static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
+{
+    int s;
+    if (first) {
+        memset(first, 0, sizeof *first);
+        first->kind = ODHS_EVENT_NONE;
+    }
+    if (!st->ready && (s = odhs_stepper_reset(st))) return s;
+    if (st->jammed) return sterr(st, ODHS_POTENTIALLY_JAMMED, "the network is potentially jammed");
+    if ((s = snapshot(st))) return s;
+    st->nchg = 0;
+    if (st->drv_version != st->drv->version) {
+        /* the driver changed since the forces were solved: re-solve now */
+        if ((s = check_driver(st))) goto fail;
+        if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) {
+            s = sterr(st, s, "%s", st->drv->errmsg);
+            goto fail;
+        }
+        if ((s = eval_forces(st)) || (s = rewire(st))) goto fail;
+        st->drv_version = st->drv->version;
+    }
+    double tplan = st->dt * st->tau;
+    if (limit < tplan) tplan = limit;
+
+    /* neighbour-list validity over the step */
+    double rate = skin_rate(st, st->G, st->U);
+    if (st->nb_stale || skin_used(st) + rate * tplan > st->skin) {
+        st->nb_stale = 0;
+        if ((s = build_neighbours(st))) goto fail;
+        rate = skin_rate(st, st->G, st->U);
+        if (rate * tplan > 0.9 * st->skin) tplan = 0.9 * st->skin / rate;
+    }
+    size_t ci, cj;
+    double t = predict(st, st->G, st->U, tplan, EPS_V * velocity_scale(st), &ci, &cj);
+    double G[9];
+    memcpy(G, st->G, sizeof G);
+    advance(st, G, st->U, t);
+    st->time += t;
+    st->strain += t * st->drv->gdot;
+    st->nsteps++;
+    odhs_network *net = st->net;
+    if (ci != SIZE_MAX) {
+        size_t c = odhs__net_add(net, ci, cj, ODHS_CONTACT_TEMPORARY);
+        if (c == SIZE_MAX || record_change(st, ci, cj, +1)) {
+            s = sterr(st, ODHS_E_NOMEM, "out of memory");
+            goto fail;
+        }
+    }
+    odhs__net_geometry(net, st->sys);
+    if ((s = eval_forces(st))) goto fail;
+    if (ci != SIZE_MAX) {
+        if ((s = check_jammed(st))) goto fail;
+    }
+    if (!st->jammed) {
+        if ((s = rewire(st))) goto fail;
+        if (st->corr_every && st->nsteps % st->corr_every == 0) {
+            int added = 0;
+            if ((s = correct(st, &added))) goto fail;
+            if (!st->jammed && (s = rewire(st))) goto fail;
+        }
+    }
+    if ((s = emit_events(st, first, stop))) goto fail;
+    return st->jammed ? ODHS_POTENTIALLY_JAMMED : ODHS_OK;
+fail:
+    rollback(st);
+    st->nsteps = st->nsteps ? st->nsteps - 1 : 0;
+    st->nchg = 0;
+    return s;
+}
+
+static int emit_events(odhs_stepper *st, odhs_event *first, int *stop)
+{
+    int s = collect_events(st);
+    if (s) return s;
+    for (size_t k = 0; k < st->nev; ++k) {
+        if (st->ev[k].kind == ODHS_EVENT_COLLISION) st->ncoll++;
+        else st->nopen++;
+    }
+    if (first && st->nev) *first = st->ev[0];
+    if (st->evfn)
+        for (size_t k = 0; k < st->nev; ++k)
+            if (st->evfn(&st->ev[k], st->evctx)) *stop = 1;
+    return ODHS_OK;
+}
+
+int odhs_stepper_correct(odhs_stepper *st)
+{
+    if (!st) return ODHS_E_NULL;
+    int s, stop = 0, added = 0;
+    if (!st->ready && (s = odhs_stepper_reset(st))) return s;
+    if (st->jammed) return sterr(st, ODHS_POTENTIALLY_JAMMED, "the network is potentially jammed");
+    if ((s = snapshot(st))) return s;
+    st->nchg = 0;
+    if ((s = correct(st, &added))) goto fail;
+    if (!st->jammed && (s = rewire(st))) goto fail;
+    if ((s = emit_events(st, NULL, &stop))) goto fail;
+    if (st->jammed) return ODHS_POTENTIALLY_JAMMED;
+    return stop ? ODHS_STOPPED : ODHS_OK;
+fail:
+    rollback(st);
+    st->nchg = 0;
+    return s;
+}
+
+int odhs_stepper_step(odhs_stepper *st, odhs_event *ev)
+{
+    if (!st) return ODHS_E_NULL;
+    int stop = 0;
+    int s = do_step(st, INFINITY, ev, &stop);
+    if (s) return s;
+    return stop ? ODHS_STOPPED : ODHS_OK;
+}
+
+/* generic run loop: remaining() gives the time left to the target (<= 0: done) */
+typedef double (*remaining_fn)(const odhs_stepper *st, const void *arg);
+
+static int run(odhs_stepper *st, remaining_fn rem, const void *arg, uint64_t max_events)
+{
+    uint64_t ev0 = st->ncoll + st->nopen;
+    for (;;) {
+        double left = rem ? rem(st, arg) : INFINITY;
+        if (!(left > 0.0)) return ODHS_OK;
+        if (max_events && st->ncoll + st->nopen - ev0 >= max_events) return ODHS_OK;
+        int stop = 0;
+        int s = do_step(st, left, NULL, &stop);
+        if (s) return s;
+        if (stop) return ODHS_STOPPED;
+    }
+}
+
+static double rem_time(const odhs_stepper *st, const void *arg)
+{
+    double t = *(const double *)arg;
+    double left = t - st->time;
+    return left > 1e-15 * fabs(t) ? left : 0.0;
+}
+
+int odhs_stepper_run_until_time(odhs_stepper *st, double t)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(t)) return sterr(st, ODHS_E_NONFINITE, "target time is not finite");
+    return run(st, rem_time, &t, 0);
+}
+
+static double rem_strain(const odhs_stepper *st, const void *arg)
+{
+    double g = *(const double *)arg, gd = st->drv->gdot;
+    double left = (g - st->strain) / gd;
+    return fabs(g - st->strain) > 1e-15 * fmax(fabs(g), 1e-300) && left > 0.0 ? left : 0.0;
+}
+
+int odhs_stepper_run_until_strain(odhs_stepper *st, double gamma)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(gamma)) return sterr(st, ODHS_E_NONFINITE, "target strain is not finite");
+    if (st->drv->gdot == 0.0) return sterr(st, ODHS_E_STATE, "run_until_strain needs a nonzero shear rate");
+    return run(st, rem_strain, &gamma, 0);
+}
+
+int odhs_stepper_run_events(odhs_stepper *st, uint64_t count)
+{
+    if (!st) return ODHS_E_NULL;
+    if (count == 0) return ODHS_OK;
+    return run(st, NULL, NULL, count);
+}
+
+static double rem_phi(const odhs_stepper *st, const void *arg)
+{
+    double target = *(const double *)arg, phi;
+    odhs_system_packing_fraction(st->sys, &phi);
+    if (phi >= target * (1.0 - 1e-15)) return 0.0;
+    double c = -st->G[3 * (1) + (1)]; /* current isotropic compression rate */
+    if (!(c > 0.0)) return INFINITY;
+    /* phi grows as (1 - c t)^(-d) over a straight step */
+    return (1.0 - pow(phi / target, 1.0 / st->dim)) / c;
+}
+
+int odhs_stepper_run_until_packing_fraction(odhs_stepper *st, double phi)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(phi)) return sterr(st, ODHS_E_NONFINITE, "target packing fraction is not finite");
+    if (!(phi > 0.0) || phi >= 1.0) return sterr(st, ODHS_E_INVALID, "packing fraction must be in (0,1)");
+    if (st->drv->crate <= 0.0 && !st->drv->pressure_on)
+        return sterr(st, ODHS_E_STATE, "run_until_packing_fraction needs compression or pressure driving");
+    return run(st, rem_phi, &phi, 0);
+}
+
+/* ---- observables ------------------------------------------------------------- */
+#define NEED(st, p)                                                          \
+    do {                                                                     \
+        if (!(st)) return ODHS_E_NULL;                                       \
+        if (!(p)) return sterr((st), ODHS_E_NULL, "output pointer is NULL"); \
+    } while (0)
+
+int odhs_stepper_time(const odhs_stepper *st, double *t)
+{
+    NEED(st, t);
+    *t = st->time;
+    return ODHS_OK;
+}
+
+int odhs_stepper_strain(const odhs_stepper *st, double *g)
+{
+    NEED(st, g);
+    *g = st->strain;
+    return ODHS_OK;
+}
+
+int odhs_stepper_counts(const odhs_stepper *st, uint64_t *steps, uint64_t *coll, uint64_t *open)
+{
+    if (!st) return ODHS_E_NULL;
+    if (steps) *steps = st->nsteps;
+    if (coll) *coll = st->ncoll;
+    if (open) *open = st->nopen;
+    return ODHS_OK;
+}
+
+static int need_ready(const odhs_stepper *st)
+{
+    if (!st->ready) return sterr(st, ODHS_E_STATE, "no valid state yet: call odhs_stepper_reset or step first");
+    return ODHS_OK;
+}
+
+int odhs_stepper_stress(const odhs_stepper *st, double *sigma)
+{
+    NEED(st, sigma);
+    int s = need_ready(st);
+    if (s) return s;
+    int dim = st->dim;
+    const odhs_network *net = st->net;
+    double vol;
+    odhs_system_volume(st->sys, &vol);
+    for (int a = 0; a < dim * dim; ++a) sigma[a] = 0.0;
+    for (size_t c = 0; c < net->nc; ++c) {
+        const double *n = net->nrm + c * dim;
+        double w = net->f[c] * net->dist[c];
+        for (int a = 0; a < dim; ++a)
+            for (int b = 0; b < dim; ++b) sigma[a * dim + b] -= w * n[a] * n[b];
+    }
+    for (int a = 0; a < dim * dim; ++a) sigma[a] /= vol;
+    return ODHS_OK;
+}
+
+int odhs_stepper_shear_stress(const odhs_stepper *st, double *sxy)
+{
+    NEED(st, sxy);
+    double sig[9];
+    int s = odhs_stepper_stress(st, sig);
+    if (s) return s;
+    *sxy = sig[1];
+    return ODHS_OK;
+}
+
+int odhs_stepper_pressure(const odhs_stepper *st, double *p)
+{
+    NEED(st, p);
+    int s = need_ready(st);
+    if (s) return s;
+    const odhs_network *net = st->net;
+    double vol, fr = 0.0;
+    odhs_system_volume(st->sys, &vol);
+    for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
+    *p = fr / (vol * st->dim);
+    return ODHS_OK;
+}
+
+int odhs_stepper_kappa(const odhs_stepper *st, double *kappa)
+{
+    NEED(st, kappa);
+    *kappa = st->kappa;
+    return ODHS_OK;
+}
+
+int odhs_stepper_dissipation(const odhs_stepper *st, double *D)
+{
+    NEED(st, D);
+    int s = need_ready(st);
+    if (s) return s;
+    double sum = 0.0;
+    for (size_t k = 0; k < st->nd; ++k) sum += st->U[k] * st->U[k];
+    *D = sum / st->drv->xi0;
+    return ODHS_OK;
+}
+
+int odhs_stepper_power(const odhs_stepper *st, double *P)
+{
+    NEED(st, P);
+    int s = need_ready(st);
+    if (s) return s;
+    const odhs_network *net = st->net;
+    int dim = st->dim;
+    double p = 0.0;
+    for (size_t c = 0; c < net->nc; ++c) {
+        const double *n = net->nrm + c * dim;
+        double d[3] = {0, 0, 0}, gd[3];
+        for (int k = 0; k < dim; ++k) d[k] = n[k] * net->dist[c];
+        apply_G(st->G, dim, d, gd);
+        double v = 0.0;
+        for (int k = 0; k < dim; ++k) v += gd[k] * n[k];
+        p -= net->f[c] * v;
+    }
+    if (st->has_F)
+        for (size_t k = 0; k < st->nd; ++k) p += st->F[k] * st->U[k];
+    *P = p;
+    return ODHS_OK;
+}
+
+int odhs_stepper_velocities(const odhs_stepper *st, double *V)
+{
+    NEED(st, V);
+    int s = need_ready(st);
+    if (s) return s;
+    int dim = st->dim;
+    for (size_t i = 0; i < st->n; ++i) {
+        double gx[3];
+        apply_G(st->G, dim, st->sys->x + i * dim, gx);
+        for (int k = 0; k < dim; ++k) V[i * dim + k] = gx[k] + st->U[i * dim + k];
+    }
+    return ODHS_OK;
+}
+
+int odhs_stepper_nonaffine_velocities(const odhs_stepper *st, double *U)
+{
+    NEED(st, U);
+    int s = need_ready(st);
+    if (s) return s;
+    memcpy(U, st->U, st->nd * sizeof *U);
+    return ODHS_OK;
+}
+
+int odhs_stepper_coordination(const odhs_stepper *st, double *z)
+{
+    NEED(st, z);
+    return odhs_network_coordination(st->net, z);
+}
+
+const odhs_network *odhs_stepper_network(const odhs_stepper *st) { return st ? st->net : NULL; }
+
+typedef struct {
+    const double *r;
+    double worst;
+} ov_ctx;
+
+static int ov_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    ov_ctx *c = vctx;
+    double rel = -gap / (c->r[i] + c->r[j]);
+    if (rel > c->worst) c->worst = rel;
+    return 0;
+}
+
+int odhs_stepper_errors(const odhs_stepper *st, double *contact_gap, double *overlap)
+{
+    if (!st) return ODHS_E_NULL;
+    const odhs_system *s = st->sys;
+    const odhs_network *net = st->net;
+    if (contact_gap) {
+        double g = 0.0;
+        for (size_t c = 0; c < net->nc; ++c)
+            g = fmax(g, fabs(net->gap[c]) / (s->r[net->ci[c]] + s->r[net->cj[c]]));
+        *contact_gap = g;
+    }
+    if (overlap) {
+        ov_ctx c = {s->r, -INFINITY};
+        int r = odhs__pairs(s->dim, s->n, s->x, s->r, s->rmax, s->L, s->gamma, 0.0, ov_cb, &c);
+        if (r == ODHS_E_NOMEM) return sterr(st, r, "out of memory");
+        *overlap = c.worst > 0.0 ? c.worst : 0.0;
+    }
+    return ODHS_OK;
+}
