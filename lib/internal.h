@@ -5,6 +5,7 @@
 #ifndef ODHS_INTERNAL_H
 #define ODHS_INTERNAL_H
 
+#include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -59,6 +60,14 @@ struct odhs_system {
 /* record an error message on a (logically mutable) handle */
 int odhs__syserr(const odhs_system *sys, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
 
+/* Lees-Edwards remapping: replace b by b -/+ a until |gamma*Ly| <= Lx/2; the
+ * lattice (and so the physical configuration) is unchanged. */
+static inline double odhs__remap_strain(double gamma, const double *L)
+{
+    double u = L[0] / L[1];
+    return gamma - nearbyint(gamma / u) * u;
+}
+
 /* Wrap one position (dim entries) into the primary lab rectangle, given box
  * and strain. A position already inside is left untouched bit for bit. */
 void odhs__wrap(int dim, const double *L, double gamma, double *x);
@@ -112,6 +121,7 @@ struct odhs_solver {
     void *state;
     const odhs_network *last_net;
     uint64_t last_version;
+    uint64_t last_sum; /* checksum of the operator last set up (public path) */
     int have_setup;
     double check_tol;
     double last_residual;
@@ -120,6 +130,13 @@ struct odhs_solver {
     size_t work_cap;
     char errmsg[ODHS_ERRMSG_LEN];
 };
+
+/* Solve N x = b. reuse = 1: skip the backend setup when this network's
+ * version is the one last set up (callers that own the network and call
+ * odhs__solver_invalidate when it may have been replaced); reuse = 0: set up
+ * whenever the backend has a setup. */
+int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse);
+void odhs__solver_invalidate(odhs_solver *s);
 
 /* ---- driver ---------------------------------------------------------------- */
 struct odhs_driver {
@@ -186,6 +203,7 @@ struct odhs_stepper {
     /* rollback snapshot */
     double *xs;
     double Ls[3], gammas, times, strains, kappas;
+    uint64_t nsteps_s;
     double Gs[9];
     int nb_stale;
     size_t *sci, *scj;

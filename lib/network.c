@@ -510,6 +510,18 @@ int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon
     return ODHS_OK;
 }
 
+int odhs_network_rattlers(const odhs_network *net, unsigned char *is_rattler, size_t *count)
+{
+    if (!net) return ODHS_E_NULL;
+    size_t nbar;
+    int st = odhs_network_constrained(net, &nbar, NULL, is_rattler, NULL);
+    if (st) return st;
+    if (is_rattler)
+        for (size_t i = 0; i < net->n; ++i) is_rattler[i] = !is_rattler[i];
+    if (count) *count = net->n - nbar;
+    return ODHS_OK;
+}
+
 int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
 {
     if (!net) return ODHS_E_NULL;

@@ -94,7 +94,34 @@ int odhs_solver_set_check_tolerance(odhs_solver *s, double tol)
     return ODHS_OK;
 }
 
+void odhs__solver_invalidate(odhs_solver *s)
+{
+    if (s) s->have_setup = 0;
+}
+
 int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x)
+{
+    return odhs__solver_solve(s, net, b, x, 0);
+}
+
+/* FNV-1a over the contact pattern and geometry: identifies the operator even
+ * when a destroyed network's address is reused by a new one */
+static uint64_t net_checksum(const odhs_network *net)
+{
+    uint64_t h = 1469598103934665603ULL;
+    const unsigned char *p[3] = {(const unsigned char *)net->ci, (const unsigned char *)net->cj,
+                                 (const unsigned char *)net->nrm};
+    size_t len[3] = {net->nc * sizeof *net->ci, net->nc * sizeof *net->cj,
+                     net->nc * (size_t)net->dim * sizeof *net->nrm};
+    for (int a = 0; a < 3; ++a)
+        for (size_t k = 0; k < len[a]; ++k) {
+            h ^= p[a][k];
+            h *= 1099511628211ULL;
+        }
+    return h ^ net->nc;
+}
+
+int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse)
 {
     if (!s) return ODHS_E_NULL;
     if (!net) return solerr(s, ODHS_E_NULL, "network is NULL");
@@ -111,7 +138,9 @@ int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, 
         s->work_cap = need;
     }
     int st;
-    if (s->type->setup && (!s->have_setup || s->last_net != net || s->last_version != net->version)) {
+    uint64_t sum = (reuse || !s->type->setup) ? 0 : net_checksum(net);
+    if (s->type->setup && (!s->have_setup || s->last_net != net || s->last_version != net->version ||
+                           (!reuse && sum != s->last_sum))) {
         st = s->type->setup(s->state, net);
         if (st) {
             s->have_setup = 0;
@@ -121,17 +150,19 @@ int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, 
         s->have_setup = 1;
         s->last_net = net;
         s->last_version = net->version;
+        s->last_sum = sum;
     }
     if (!(s->type->flags & ODHS_SOLVER_USES_GUESS)) memset(x, 0, nc * sizeof *x);
     st = s->type->solve(s->state, net, b, x);
     s->nsolves += 1.0;
-    if (st < 0) return solerr(s, st, "%s: solve failed (%s)", s->type->name, odhs_strerror(st));
-    /* check the result: finite, small residual */
+    /* check the result: finite, small residual (also recorded after a failure) */
     double *Nx = s->work, *tmp = s->work + nc;
     for (size_t c = 0; c < nc; ++c)
-        if (!isfinite(x[c]))
-            return solerr(s, ODHS_E_SINGULAR, "%s: solution is not finite (singular network?)",
+        if (!isfinite(x[c])) {
+            s->last_residual = INFINITY;
+            return solerr(s, st < 0 ? st : ODHS_E_SINGULAR, "%s: solution is not finite (singular network?)",
                           s->type->name);
+        }
     odhs__net_N(net, x, Nx, tmp);
     double rn = 0.0, bn = 0.0;
     for (size_t c = 0; c < nc; ++c) {
@@ -140,6 +171,9 @@ int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, 
         bn += b[c] * b[c];
     }
     s->last_residual = bn > 0.0 ? sqrt(rn / bn) : sqrt(rn);
+    if (st < 0)
+        return solerr(s, st, "%s: solve failed (%s), relative residual %.3g", s->type->name, odhs_strerror(st),
+                      s->last_residual);
     if (s->last_residual > s->check_tol) {
         int code = (s->type->flags & ODHS_SOLVER_ITERATIVE) ? ODHS_E_NOCONV : ODHS_E_SINGULAR;
         return solerr(s, code, "%s: relative residual %.3g above %.3g", s->type->name, s->last_residual,

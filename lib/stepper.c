@@ -116,7 +116,7 @@ static int eval_forces(odhs_stepper *st)
 /* ---- forces and velocities on the current network ---------------------- */
 static int solve(odhs_stepper *st, const double *b, double *x)
 {
-    int s = odhs_solver_solve(st->sol, st->net, b, x);
+    int s = odhs__solver_solve(st->sol, st->net, b, x, 1);
     if (s) return sterr(st, s, "force solve: %s", odhs_solver_errmsg(st->sol));
     return ODHS_OK;
 }
@@ -443,7 +443,7 @@ static void advance(odhs_stepper *st, const double *G, const double *vel, double
     double scale = 1.0 + t * G[3 * (1) + (1)];
     double g = s->gamma + t * G[3 * (0) + (1)] / scale;
     for (int k = 0; k < dim; ++k) s->L[k] *= scale;
-    g -= nearbyint(g);
+    g = odhs__remap_strain(g, s->L);
     s->gamma = g;
     double Mn[9];
     for (int a = 0; a < 3; ++a)
@@ -478,7 +478,13 @@ static int snapshot(odhs_stepper *st)
     st->gammas = st->sys->gamma;
     st->times = st->time;
     st->strains = st->strain;
+    st->nsteps_s = st->nsteps;
     st->snc = net->nc;
+    if (net->nc == 0) {
+        memcpy(st->Gs, st->G, sizeof st->Gs);
+        st->kappas = st->kappa;
+        return ODHS_OK;
+    }
     memcpy(st->Gs, st->G, sizeof st->Gs);
     st->kappas = st->kappa;
     memcpy(st->sci, net->ci, net->nc * sizeof *st->sci);
@@ -496,6 +502,7 @@ static void rollback(odhs_stepper *st)
     st->sys->gamma = st->gammas;
     st->time = st->times;
     st->strain = st->strains;
+    st->nsteps = st->nsteps_s;
     odhs_network_clear(net);
     for (size_t c = 0; c < st->snc; ++c) {
         size_t k = odhs__net_add(net, st->sci[c], st->scj[c], st->skind[c]);
@@ -615,6 +622,7 @@ int odhs_stepper_reset(odhs_stepper *st)
     int s;
     st->ready = 0;
     st->jammed = 0;
+    odhs__solver_invalidate(st->sol); /* our network may reuse a freed address */
     if ((s = check_driver(st))) return s;
     if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) return sterr(st, s, "%s", st->drv->errmsg);
     /* keep permanent contacts, rebuild the temporary ones */
@@ -642,16 +650,24 @@ int odhs_stepper_reset(odhs_stepper *st)
 static int correct(odhs_stepper *st, int *added)
 {
     odhs_network *net = st->net;
+    const odhs_system *sys = st->sys;
     int s;
     double Z[9] = {0};
-    for (int pass = 0; pass < 50; ++pass) {
+    double prev = INFINITY;
+    /* Newton-like passes: each removes the gaps to first order (the residual
+     * is second order), so a few passes reach round-off; a pass cut short by a
+     * collision adds that contact and starts again. */
+    for (int pass = 0; pass < 60; ++pass) {
         size_t nc = net->nc;
         if (nc == 0) return ODHS_OK;
-        odhs__net_geometry(net, st->sys);
+        odhs__net_geometry(net, sys);
         if ((s = reserve_contacts(st, nc))) return sterr(st, s, "out of memory");
         double gmax = 0.0;
-        for (size_t c = 0; c < nc; ++c) gmax = fmax(gmax, fabs(net->gap[c]));
-        if (gmax == 0.0) return ODHS_OK;
+        for (size_t c = 0; c < nc; ++c)
+            gmax = fmax(gmax, fabs(net->gap[c]) / (sys->r[net->ci[c]] + sys->r[net->cj[c]]));
+        if (gmax <= 4e-16) return ODHS_OK;            /* at round-off */
+        if (!(gmax < 0.5 * prev)) return ODHS_OK;     /* no further progress */
+        prev = gmax;
         memset(st->cx, 0, nc * sizeof *st->cx);
         if ((s = solve(st, net->gap, st->cx))) return s;
         odhs__net_ST(net, st->cx, st->tmp);
@@ -659,17 +675,19 @@ static int correct(odhs_stepper *st, int *added)
         size_t pi, pj;
         double t = predict(st, Z, st->tmp, 1.0, 0.0, &pi, &pj);
         advance(st, Z, st->tmp, t);
-        if (pi == SIZE_MAX) {
-            odhs__net_geometry(net, st->sys);
-            return ODHS_OK;
+        if (pi != SIZE_MAX) {
+            size_t c = odhs__net_add(net, pi, pj, ODHS_CONTACT_TEMPORARY);
+            if (c == SIZE_MAX || record_change(st, pi, pj, +1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
+            *added = 1;
+            if ((s = check_jammed(st))) return s;
+            if (st->jammed) {
+                odhs__net_geometry(net, sys);
+                return ODHS_OK;
+            }
+            prev = INFINITY; /* new contact: a new problem */
         }
-        size_t c = odhs__net_add(net, pi, pj, ODHS_CONTACT_TEMPORARY);
-        if (c == SIZE_MAX || record_change(st, pi, pj, +1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
-        *added = 1;
-        if ((s = check_jammed(st))) return s;
-        if (st->jammed) return ODHS_OK;
     }
-    odhs__net_geometry(net, st->sys);
+    odhs__net_geometry(net, sys);
     return ODHS_OK;
 }
 
@@ -720,7 +738,9 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
         first->kind = ODHS_EVENT_NONE;
     }
     if (!st->ready && (s = odhs_stepper_reset(st))) return s;
-    if (st->jammed) return sterr(st, ODHS_POTENTIALLY_JAMMED, "the network is potentially jammed");
+    if (st->jammed)
+        return sterr(st, ODHS_POTENTIALLY_JAMMED,
+                     "the network is potentially jammed (N = S S^T singular): no further steps");
     if ((s = snapshot(st))) return s;
     st->nchg = 0;
     if (st->drv_version != st->drv->version) {
@@ -732,6 +752,13 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
         }
         if ((s = eval_forces(st)) || (s = rewire(st))) goto fail;
         st->drv_version = st->drv->version;
+        if (st->nchg) {
+            /* the new driving opened or closed contacts: that is this step's
+             * event, at the current time and with no motion */
+            st->nsteps++;
+            if ((s = emit_events(st, first, stop))) goto fail;
+            return ODHS_OK;
+        }
     }
     double tplan = st->dt * st->tau;
     if (limit < tplan) tplan = limit;
@@ -774,10 +801,12 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
         }
     }
     if ((s = emit_events(st, first, stop))) goto fail;
-    return st->jammed ? ODHS_POTENTIALLY_JAMMED : ODHS_OK;
+    if (st->jammed)
+        return sterr(st, ODHS_POTENTIALLY_JAMMED,
+                     "potentially jammed at t = %.17g: the constrained subset became isostatic", st->time);
+    return ODHS_OK;
 fail:
     rollback(st);
-    st->nsteps = st->nsteps ? st->nsteps - 1 : 0;
     st->nchg = 0;
     return s;
 }

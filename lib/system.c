@@ -160,7 +160,7 @@ static int commit(odhs_system *sys, const double *L, double gamma, double *r, in
     int st;
     double rmax = 0.0;
     if (!isfinite(gamma)) return odhs__syserr(sys, ODHS_E_NONFINITE, "strain is not finite");
-    gamma -= nearbyint(gamma);
+    gamma = odhs__remap_strain(gamma, L);
     if (has_r && (st = check_radii(sys, r, &rmax))) return st;
     /* the box must hold two largest diameters once particles are placed */
     if ((st = check_box(sys, L, (has_r && has_x) ? rmax : 0.0))) return st;

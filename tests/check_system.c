@@ -102,11 +102,12 @@ static void state_free(state *o)
     free(o->r);
 }
 
-/* Compare odhs_system_for_each_pair with brute force at one max_gap. */
-static void compare_pairs(const odhs_system *s, double max_gap, const char *what)
+/* Compare odhs_system_for_each_pair at max_gap with the brute-force list
+ * `all` (pairs within some larger gap, sorted), filtered to max_gap. */
+static void compare_pairs_with(const odhs_system *s, const state *op, const tu_pairlist *all,
+                               double max_gap, const char *what)
 {
-    state o;
-    state_get(s, &o);
+    const state o = *op;
     tu_pairlist got, want;
     tu_pairlist_init(&got, o.dim);
     int st = odhs_system_for_each_pair(s, max_gap, tu_pair_collect, &got);
@@ -119,7 +120,10 @@ static void compare_pairs(const odhs_system *s, double max_gap, const char *what
     tu_pairlist_sort(&got);
     ck_assert_msg(tu_pairlist_duplicates(&got) == 0, "%s max_gap %g: %zu pairs reported twice", what,
                   max_gap, tu_pairlist_duplicates(&got));
-    tu_brute_pairs(o.dim, o.n, o.x, o.r, o.L, o.gamma, max_gap, &want);
+    tu_pairlist_init(&want, o.dim);
+    for (size_t k = 0; k < all->n; ++k)
+        if (all->p[k].gap <= max_gap)
+            tu_pairlist_push(&want, all->p[k].i, all->p[k].j, all->p[k].rij, all->p[k].gap);
     ck_assert(!want.alloc_failed);
     size_t a = 0, b = 0;
     for (; a < got.n && b < want.n; ++a, ++b) {
@@ -158,7 +162,26 @@ static void compare_pairs(const odhs_system *s, double max_gap, const char *what
     }
     tu_pairlist_free(&got);
     tu_pairlist_free(&want);
+}
+
+/* Compare odhs_system_for_each_pair with brute force at each of the gaps. */
+static void compare_pairs_n(const odhs_system *s, const double *gaps, int ngaps, const char *what)
+{
+    state o;
+    state_get(s, &o);
+    double gmax = 0.0;
+    for (int k = 0; k < ngaps; ++k) gmax = fmax(gmax, gaps[k]);
+    tu_pairlist all;
+    tu_brute_pairs(o.dim, o.n, o.x, o.r, o.L, o.gamma, gmax, &all);
+    ck_assert(!all.alloc_failed);
+    for (int k = 0; k < ngaps; ++k) compare_pairs_with(s, &o, &all, gaps[k], what);
+    tu_pairlist_free(&all);
     state_free(&o);
+}
+
+static void compare_pairs(const odhs_system *s, double max_gap, const char *what)
+{
+    compare_pairs_n(s, &max_gap, 1, what);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -346,13 +369,11 @@ START_TEST(test_null_arguments)
     EXPECT_FAIL(s, ODHS_E_NULL, odhs_system_packing_fraction(s, NULL));
     EXPECT_FAIL(s, ODHS_E_NULL, odhs_system_separation(s, 0, 1, NULL, &v, NULL));
     EXPECT_FAIL(s, ODHS_E_NULL, odhs_system_for_each_pair(s, 0.1, NULL, NULL));
-    odhs_system *c = (odhs_system *)&c;
     ck_assert_int_eq(odhs_system_clone(s, NULL), ODHS_E_NULL);
     /* optional outputs may be NULL */
     double rij[3];
     ck_assert_int_eq(odhs_system_separation(s, 0, 1, rij, NULL, NULL), ODHS_OK);
     ck_assert_int_eq(odhs_system_get_species(s, 1, buf, sizeof buf), ODHS_OK);
-    (void)c;
     odhs_system_destroy(s);
 }
 END_TEST
@@ -519,7 +540,12 @@ START_TEST(test_min_image)
             ck_assert_int_eq(odhs_system_set_box(s, L), ODHS_OK);
             ck_assert_int_eq(odhs_system_set_strain(s, gamma), ODHS_OK);
             ck_assert_int_eq(odhs_system_get_strain(s, &g), ODHS_OK);
-            ck_assert_msg(g == gamma, "strain %g stored as %.17g", gamma, g);
+            /* stored strain: the same lattice, remapped by multiples of Lx/Ly */
+            {
+                double u = L[0] / L[1], k = nearbyint((gamma - g) / u);
+                ck_assert_msg(fabs(gamma - g - k * u) <= 1e-14 && fabs(g) <= 0.5 * u * (1 + 1e-14),
+                              "strain %g stored as %.17g (Lx/Ly = %g)", gamma, g, u);
+            }
             for (size_t k = 0; k < n * (size_t)dim; ++k) x[k] = tu_uniform(&rng) * L[k % dim];
             ck_assert_int_eq(odhs_system_set_positions(s, x), ODHS_OK);
             char what[96];
@@ -742,6 +768,39 @@ START_TEST(test_wrap_outside)
 }
 END_TEST
 
+START_TEST(test_wrap_on_set_box)
+{
+    /* shrinking the box (no scaling) wraps the positions into the new box:
+     * each stays the same point of the new sheared lattice */
+    int dim = 2 + _i;
+    const double L[3] = {4.0, 5.0, 3.0}, Ln[3] = {2.5, 3.2, 1.9};
+    tu_rng rng;
+    tu_rng_seed(&rng, 31 + (uint64_t)dim);
+    const size_t n = 50;
+    double x[150], out[150];
+    for (size_t k = 0; k < n * (size_t)dim; ++k) x[k] = tu_uniform(&rng) * L[k % dim];
+    odhs_system *s = new_sys(dim, n);
+    ck_assert_int_eq(odhs_system_set_box(s, L), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_strain(s, 0.41), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_positions(s, x), ODHS_OK);
+    /* the strain is defined modulo Lx/Ly of the box it was set in: set_box
+     * keeps the stored representative, which defines the new lattice */
+    double gs;
+    ck_assert_int_eq(odhs_system_get_strain(s, &gs), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_box(s, Ln), ODHS_OK);
+    ck_assert_int_eq(odhs_system_get_positions(s, out), ODHS_OK);
+    size_t moved = 0;
+    for (size_t i = 0; i < n; ++i) {
+        char what[64];
+        snprintf(what, sizeof what, "%dD set_box particle %zu", dim, i);
+        check_same_lattice_point(dim, Ln, gs, x + i * dim, out + i * dim, what);
+        moved += memcmp(x + i * dim, out + i * dim, (size_t)dim * sizeof(double)) != 0;
+    }
+    ck_assert(moved > n / 4);
+    odhs_system_destroy(s);
+}
+END_TEST
+
 START_TEST(test_wrap_inside_bitwise)
 {
     int dim = 2 + _i;
@@ -802,42 +861,123 @@ typedef struct {
     double gamma;
     uint64_t seed;
     const char *name;
+    double rmin; /* smallest radius (the largest is 0.5) */
 } pair_case;
 
 static const pair_case pair_cases[] = {
-    {2, 120, {8, 8, 0}, 0.0, 11, "2D cubic"},
-    {2, 120, {8, 8, 0}, 0.5, 12, "2D strain 0.5"},
-    {2, 120, {8, 8, 0}, -0.5, 13, "2D strain -0.5"},
-    {2, 120, {8, 8, 0}, 0.37, 14, "2D strain 0.37"},
-    {2, 150, {12, 6, 0}, 0.37, 15, "2D Lx=2Ly strain 0.37"},
-    {2, 150, {6, 12, 0}, -0.37, 16, "2D Lx=Ly/2 strain -0.37"},
-    {2, 150, {12, 6, 0}, -0.5, 17, "2D Lx=2Ly strain -0.5"},
-    {2, 10, {2.6, 2.6, 0}, 0.5, 18, "2D small box strain 0.5"},
-    {2, 14, {3.3, 2.7, 0}, -0.37, 19, "2D small box strain -0.37"},
-    {2, 12, {2.1, 4.5, 0}, 0.0, 20, "2D small Lx"},
-    {2, 200, {60, 60, 0}, 0.37, 21, "2D large sparse strain 0.37"},
-    {3, 350, {5, 5, 5}, 0.0, 31, "3D cubic"},
-    {3, 350, {5, 5, 5}, 0.5, 32, "3D strain 0.5"},
-    {3, 350, {5, 5, 5}, -0.5, 33, "3D strain -0.5"},
-    {3, 400, {8, 4, 5}, 0.37, 34, "3D Lx=2Ly strain 0.37"},
-    {3, 300, {4, 8, 5}, -0.37, 35, "3D Lx=Ly/2 strain -0.37"},
-    {3, 20, {2.5, 2.5, 2.5}, -0.5, 36, "3D small box strain -0.5"},
-    {3, 12, {2.2, 2.4, 2.3}, 0.37, 37, "3D small box strain 0.37"},
-    {3, 300, {30, 30, 30}, 0.37, 38, "3D large sparse strain 0.37"},
+    {2, 120, {8, 8, 0}, 0.0, 11, "2D cubic", 0.05},
+    {2, 120, {8, 8, 0}, 0.5, 12, "2D strain 0.5", 0.05},
+    {2, 120, {8, 8, 0}, -0.5, 13, "2D strain -0.5", 0.05},
+    {2, 120, {8, 8, 0}, 0.37, 14, "2D strain 0.37", 0.05},
+    {2, 150, {12, 6, 0}, 0.37, 15, "2D Lx=2Ly strain 0.37", 0.05},
+    {2, 150, {6, 12, 0}, -0.37, 16, "2D Lx=Ly/2 strain -0.37", 0.05},
+    {2, 150, {12, 6, 0}, -0.5, 17, "2D Lx=2Ly strain -0.5", 0.05},
+    {2, 10, {2.6, 2.6, 0}, 0.5, 18, "2D small box strain 0.5", 0.05},
+    {2, 14, {3.3, 2.7, 0}, -0.37, 19, "2D small box strain -0.37", 0.05},
+    {2, 12, {2.1, 4.5, 0}, 0.0, 20, "2D small Lx", 0.05},
+    {2, 200, {60, 60, 0}, 0.37, 21, "2D large sparse strain 0.37", 0.05},
+    {3, 350, {5, 5, 5}, 0.0, 31, "3D cubic", 0.05},
+    {3, 350, {5, 5, 5}, 0.5, 32, "3D strain 0.5", 0.05},
+    {3, 350, {5, 5, 5}, -0.5, 33, "3D strain -0.5", 0.05},
+    {3, 400, {8, 4, 5}, 0.37, 34, "3D Lx=2Ly strain 0.37", 0.05},
+    {3, 300, {4, 8, 5}, -0.37, 35, "3D Lx=Ly/2 strain -0.37", 0.05},
+    {3, 20, {2.5, 2.5, 2.5}, -0.5, 36, "3D small box strain -0.5", 0.05},
+    {3, 12, {2.2, 2.4, 2.3}, 0.37, 37, "3D small box strain 0.37", 0.05},
+    {3, 300, {30, 30, 30}, 0.37, 38, "3D large sparse strain 0.37", 0.05},
+    /* nearly monodisperse: many pairs close to the pair range 2 rmax + max_gap */
+    {2, 95, {12, 12, 0}, 0.5, 41, "2D near-monodisperse strain 0.5", 0.4},
+    {2, 95, {12, 12, 0}, -0.37, 42, "2D near-monodisperse strain -0.37", 0.4},
+    {3, 150, {6, 6, 6}, -0.5, 43, "3D near-monodisperse strain -0.5", 0.4},
+    {3, 150, {6, 6, 6}, 0.37, 44, "3D near-monodisperse strain 0.37", 0.4},
 };
 #define N_PAIR_CASES ((int)(sizeof pair_cases / sizeof pair_cases[0]))
 
 START_TEST(test_pairs_brute)
 {
     const pair_case *pc = &pair_cases[_i];
-    odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, 0.05, 0.5, pc->seed);
+    odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, pc->rmin, 0.5, pc->seed);
     double limit = 0.5 * min_edge(pc->dim, pc->L) - 2.0 * 0.5; /* max_gap must stay below */
     ck_assert(limit > 0.0);
     const double fr[] = {0.0, 0.1, 0.3, 0.6, 0.99};
     double gaps[7] = {0.0, 0.01};
     for (int k = 0; k < 5; ++k) gaps[2 + k] = fr[k] * limit;
-    for (int k = 0; k < 7; ++k) compare_pairs(s, gaps[k], pc->name);
+    compare_pairs_n(s, gaps, 7, pc->name);
     odhs_system_destroy(s);
+}
+END_TEST
+
+/* Pairs oriented along the direction that maximises the sheared-frame
+ * distance |dx - gamma dy| = |d| sqrt(1 + gamma^2): a cell list whose cells in
+ * x' = x - gamma y are only rc wide (ignoring the shear) misses some of them.
+ * Many tiny fillers keep the cell grid fine. */
+START_TEST(test_pairs_shear_direction)
+{
+    const double strains[] = {0.5, -0.5, 0.37};
+    int dim = 2 + _i / 3;
+    double gamma = strains[_i % 3];
+    const double rb = 0.5, rf = 0.01, gap = 0.01;
+    const double rc = 2 * rb + gap;
+    const size_t npair = 60, nfill = dim == 2 ? 260 : 560;
+    const size_t n = 2 * npair + nfill;
+    double Lv = (dim == 2 ? 19.0 : 11.0) * rc * 1.0001; /* Lv / rc just above an integer */
+    double L[3] = {Lv, Lv, Lv};
+    double *x = malloc(n * (size_t)dim * sizeof *x), *r = malloc(n * sizeof *r);
+    ck_assert(x && r);
+    /* d along (1, -gamma): dx - gamma dy = |d| sqrt(1 + gamma^2) */
+    double dir[3] = {1.0, -gamma, 0.0};
+    double nd = sqrt(1.0 + gamma * gamma);
+    dir[0] /= nd;
+    dir[1] /= nd;
+    tu_rng rng;
+    tu_rng_seed(&rng, 555 + (uint64_t)_i);
+    for (size_t i = 0; i < n; ++i) r[i] = i < 2 * npair ? rb : rf;
+    size_t placed = 0;
+    for (int tries = 0; placed < n && tries < 2000000; ++tries) {
+        int is_pair = placed < 2 * npair;
+        double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+        for (int k = 0; k < dim; ++k) a[k] = tu_uniform(&rng) * L[k];
+        size_t cnt = is_pair ? 2 : 1;
+        if (is_pair) {
+            /* may lie outside the box: the library wraps it */
+            for (int k = 0; k < dim; ++k) b[k] = a[k] + (2 * rb + 0.9 * gap) * dir[k];
+        }
+        int ok = 1;
+        for (size_t c = 0; c < cnt && ok; ++c) {
+            const double *p = c == 0 ? a : b;
+            double rp = r[placed + c];
+            for (size_t j = 0; j < placed && ok; ++j) {
+                double d[3] = {0, 0, 0};
+                for (int k = 0; k < dim; ++k) d[k] = x[j * dim + k] - p[k];
+                double s2 = tu_min_image_fast(dim, L, gamma, d);
+                double lim = rp + r[j] + 0.05;
+                if (s2 < lim * lim) ok = 0;
+            }
+        }
+        if (!ok) continue;
+        for (int k = 0; k < dim; ++k) {
+            x[placed * dim + k] = a[k];
+            if (is_pair) x[(placed + 1) * dim + k] = b[k];
+        }
+        placed += cnt;
+    }
+    ck_assert_uint_eq(placed, n);
+    odhs_system *s = new_sys(dim, n);
+    int st = odhs_system_set_configuration(s, L, gamma, r, x);
+    ck_assert_msg(st == ODHS_OK, "%s", odhs_system_errmsg(s));
+    /* every designed pair is found */
+    tu_pairlist pl;
+    tu_pairlist_init(&pl, dim);
+    ck_assert_int_eq(odhs_system_for_each_pair(s, gap, tu_pair_collect, &pl), ODHS_OK);
+    size_t found = 0;
+    for (size_t k = 0; k < pl.n; ++k)
+        if (pl.p[k].i < 2 * npair && pl.p[k].j == pl.p[k].i + 1 && pl.p[k].i % 2 == 0) ++found;
+    ck_assert_msg(found == npair, "%dD strain %g: found %zu of %zu pairs oriented along the shear", dim,
+                  gamma, found, npair);
+    tu_pairlist_free(&pl);
+    compare_pairs(s, gap, "shear direction");
+    odhs_system_destroy(s);
+    free(x);
+    free(r);
 }
 END_TEST
 
@@ -846,7 +986,7 @@ START_TEST(test_pairs_after_scale_box)
     const int cases[] = {3, 4, 5, 12, 15, 17};
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         const pair_case *pc = &pair_cases[cases[c]];
-        odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, 0.05, 0.5, pc->seed);
+        odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, pc->rmin, 0.5, pc->seed);
         state a, b;
         state_get(s, &a);
         double phi0, phi1;
@@ -872,9 +1012,8 @@ START_TEST(test_pairs_after_scale_box)
                           phi0 / pow(tot, pc->dim));
             ck_assert_int_eq(odhs_system_validate(s, 0.0), ODHS_OK);
             double limit = 0.5 * min_edge(pc->dim, b.L) - 1.0;
-            compare_pairs(s, 0.0, pc->name);
-            compare_pairs(s, 0.05, pc->name);
-            compare_pairs(s, 0.5 * limit, pc->name);
+            const double g3[3] = {0.0, 0.05, 0.5 * limit};
+            compare_pairs_n(s, g3, 3, pc->name);
             state_free(&b);
             state_free(&before);
         }
@@ -895,7 +1034,7 @@ END_TEST
 START_TEST(test_pairs_stop)
 {
     const pair_case *pc = &pair_cases[3];
-    odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, 0.05, 0.5, pc->seed);
+    odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, pc->rmin, 0.5, pc->seed);
     tu_pairlist pl;
     tu_pairlist_init(&pl, pc->dim);
     ck_assert_int_eq(odhs_system_for_each_pair(s, 0.5, tu_pair_collect, &pl), ODHS_OK);
@@ -925,7 +1064,7 @@ START_TEST(test_pairs_invalid_gap)
 {
     for (int c = 0; c < N_PAIR_CASES; c += 6) {
         const pair_case *pc = &pair_cases[c];
-        odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, 0.05, 0.5, pc->seed);
+        odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, pc->rmin, 0.5, pc->seed);
         double limit = 0.5 * min_edge(pc->dim, pc->L) - 1.0;
         tu_pairlist pl;
         tu_pairlist_init(&pl, pc->dim);
@@ -1532,7 +1671,7 @@ START_TEST(test_volume_packing_fraction)
 {
     for (int dim = 2; dim <= 3; ++dim) {
         const pair_case *pc = &pair_cases[dim == 2 ? 4 : 14];
-        odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, 0.05, 0.5, pc->seed);
+        odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, pc->rmin, 0.5, pc->seed);
         state a;
         state_get(s, &a);
         double vol, phi, v = 0.0;
@@ -1555,7 +1694,7 @@ END_TEST
 START_TEST(test_clone)
 {
     const pair_case *pc = &pair_cases[15];
-    odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, 0.05, 0.5, pc->seed);
+    odhs_system *s = make_random_system(pc->dim, pc->n, pc->L, pc->gamma, pc->rmin, 0.5, pc->seed);
     ck_assert_int_eq(odhs_system_set_species(s, 0, "Big"), ODHS_OK);
     ck_assert_int_eq(odhs_system_set_species(s, 1, "Small"), ODHS_OK);
     odhs_system *c = NULL;
@@ -1641,11 +1780,13 @@ Suite *make_system_suite(void)
     tcase_add_loop_test(tc, test_strain_remap_nonsquare, 0, 4);
     tcase_add_loop_test(tc, test_wrap_outside, 0, 2);
     tcase_add_loop_test(tc, test_wrap_inside_bitwise, 0, 2);
+    tcase_add_loop_test(tc, test_wrap_on_set_box, 0, 2);
     tcase_add_test(tc, test_volume_packing_fraction);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("pairs");
     tcase_add_loop_test(tc, test_pairs_brute, 0, N_PAIR_CASES);
+    tcase_add_loop_test(tc, test_pairs_shear_direction, 0, 6);
     tcase_add_test(tc, test_pairs_after_scale_box);
     tcase_add_test(tc, test_pairs_stop);
     tcase_add_test(tc, test_pairs_invalid_gap);

@@ -102,6 +102,13 @@ ODHS_API int odhs_network_coordination(const odhs_network *net, double *z);
 ODHS_API int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon,
                                       unsigned char *in_subset, long *zbar_num);
 /**
+ * Rattlers: particles outside the constrained subset (fewer than d+1 contacts
+ * with constrained particles after iterative removal). is_rattler[N] (may be
+ * NULL) receives 1 for rattlers, *count (may be NULL) their number.
+ */
+ODHS_API int odhs_network_rattlers(const odhs_network *net, unsigned char *is_rattler, size_t *count);
+
+/**
  * Whether the constrained subset is potentially jammed: Ncon >= d(Nbar-1)+1
  * (equivalently zbar >= 2d, eq. 29, in integers). *flag = 1 or 0.
  */

@@ -56,7 +56,9 @@ typedef struct odhs_solver_type {
  *  forces by the stepper. */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cg;
 /** Dense Cholesky of N through LAPACK dpotrf/dpotrs. Reports a non-positive
- *  pivot (singular or hyperstatic network) as ODHS_E_SINGULAR. O(Nc^3). */
+ *  pivot, or a reciprocal condition estimate (dpocon) below "min_rcond"
+ *  (parameter, default 1e-14), as ODHS_E_SINGULAR: singular or hyperstatic
+ *  networks. Statistics: "rcond", "lapack_info". O(Nc^3) per setup. */
 ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
 
 typedef struct odhs_solver odhs_solver;
@@ -85,9 +87,12 @@ ODHS_API int odhs_solver_get_stat(const odhs_solver *s, const char *key, double 
  *  (default 1e-6; ODHS_E_NOCONV for iterative, ODHS_E_SINGULAR for direct). */
 ODHS_API int odhs_solver_set_check_tolerance(odhs_solver *s, double tol);
 /**
- * Solve N x = b on the network's current geometry. If the network changed
- * since the last solve the backend's setup runs first. x holds the initial
- * guess for backends that use one (pass zeros otherwise).
+ * Solve N x = b on the network's current geometry. The backend's setup runs
+ * first whenever the operator differs from the one last set up (another
+ * network, a change of contacts or geometry, or a new network at a freed
+ * one's address: a checksum of the contacts and normals decides). x holds the initial guess for
+ * backends that use one (pass zeros otherwise). The "residual" statistic is
+ * recorded even when the solve fails.
  */
 ODHS_API int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x);
 

@@ -16,8 +16,17 @@
  * odhs_stepper_reset).
  *
  * Time is physical time; strain is the accumulated shear strain
- * integral(gammadot dt) (the system's Lees-Edwards strain is that value
- * remapped into [-1/2, 1/2]).
+ * integral(gammadot dt). At fixed volume the system's Lees-Edwards strain is
+ * that value remapped (see system.h); under compression or fixed pressure the
+ * box tilt also follows the compression (H -> (I + t G) H), so the cell strain
+ * then differs slightly from the accumulated strain.
+ *
+ * Event times: collisions are located exactly on the step's motion; openings
+ * are found when a force is negative at the end of a step, so their time
+ * resolution is the step dt*tau (Sect. IV A (ii.b) of the paper). A change of
+ * the driver between steps is applied at the start of the next step; if it
+ * opens or closes contacts, that step ends at once with those events and no
+ * motion.
  */
 #ifndef ODHS_STEPPER_H
 #define ODHS_STEPPER_H
@@ -80,17 +89,21 @@ ODHS_API int odhs_stepper_set_event_callback(odhs_stepper *st, odhs_event_fn fn,
 ODHS_API int odhs_stepper_reset(odhs_stepper *st);
 
 /**
- * Apply the drift correction of Sect. IV C now (contact gaps back to round-off,
- * then re-solve and rewire), e.g. before saving a configuration. Events it
+ * Apply the drift correction of Sect. IV C now, repeated until the contact
+ * gaps are at round-off (a few passes: each leaves a second-order residual),
+ * then re-solve and rewire; e.g. before saving a configuration. Events it
  * causes go to the event callback. Returns like odhs_stepper_step.
  */
 ODHS_API int odhs_stepper_correct(odhs_stepper *st);
 
 /**
  * Take one step. *ev (may be NULL) receives the first event of the step, or
- * kind ODHS_EVENT_NONE. Returns ODHS_OK, ODHS_POTENTIALLY_JAMMED (no step was
- * taken: the constrained subset is isostatic), or an error (the configuration
- * is rolled back to the start of the step).
+ * kind ODHS_EVENT_NONE. Returns ODHS_OK; ODHS_POTENTIALLY_JAMMED when a
+ * collision made the constrained subset isostatic (the step up to that
+ * collision is taken, the contact is in the network, N = S S^T is singular and
+ * forces are not recomputed; every later call returns ODHS_POTENTIALLY_JAMMED
+ * without moving); or an error (the configuration is rolled back to the start
+ * of the step).
  */
 ODHS_API int odhs_stepper_step(odhs_stepper *st, odhs_event *ev);
 /** Step until physical time t (the last step is truncated to land on t). */

@@ -7,8 +7,9 @@
  *  - The box is periodic with edge lengths L = (Lx, Ly[, Lz]). Simple shear acts
  *    in the x-y plane with Lees-Edwards boundaries: the periodic lattice is
  *    spanned by a = (Lx,0,0), b = (gamma*Ly, Ly, 0), c = (0,0,Lz). The strain
- *    gamma is kept in [-1/2, 1/2] by the usual remapping (b -> b -/+ a), which
- *    leaves the physical configuration unchanged.
+ *    gamma is kept in [-Lx/(2Ly), Lx/(2Ly)] (that is [-1/2, 1/2] for Lx = Ly) by
+ *    the usual remapping b -> b -/+ a, which changes gamma by Lx/Ly and leaves
+ *    the lattice, and so the physical configuration, unchanged.
  *  - Stored positions lie in the lab rectangle [0,Lx) x [0,Ly) [x [0,Lz)]; any
  *    position passed in is wrapped there (a position already inside is kept
  *    bit for bit).
@@ -59,6 +60,8 @@ ODHS_API int odhs_system_is_ready(const odhs_system *sys);
 /**
  * Set the box edge lengths L[0..dim-1] (scales nothing: positions are wrapped
  * into the new box and checked for overlaps if radii and positions are set).
+ * The stored strain representative (see odhs_system_get_strain) is kept and
+ * remapped for the new edges.
  * Errors: ODHS_E_NONFINITE, ODHS_E_INVALID (L <= 0), and with radii and
  * positions set ODHS_E_BOX (an edge shorter than twice the largest diameter)
  * and ODHS_E_OVERLAP.
@@ -71,12 +74,12 @@ ODHS_API int odhs_system_volume(const odhs_system *sys, double *vol);
 
 /**
  * Set the Lees-Edwards strain gamma (any finite value; it is remapped into
- * [-1/2, 1/2]). The physical positions are kept; the images of the lattice
- * change. Errors: ODHS_E_NONFINITE, ODHS_E_OVERLAP (with particles set, if the
- * new images overlap).
+ * [-Lx/(2Ly), Lx/(2Ly)] as above). The positions are kept; the images of the
+ * lattice change. Errors: ODHS_E_NONFINITE, ODHS_E_OVERLAP (with particles
+ * set, if the new images overlap).
  */
 ODHS_API int odhs_system_set_strain(odhs_system *sys, double gamma);
-/** Current (remapped) Lees-Edwards strain, in [-1/2, 1/2]. */
+/** Current (remapped) Lees-Edwards strain, in [-Lx/(2Ly), Lx/(2Ly)]. */
 ODHS_API int odhs_system_get_strain(const odhs_system *sys, double *gamma);
 
 /**
@@ -171,8 +174,9 @@ ODHS_API int odhs_system_set_radii_bidisperse(odhs_system *sys, double r_small, 
  * current box edges and strain 0. Radii must be set. Reproducible from seed
  * (xoshiro256**, splitmix64 seeding; the same seed gives the same scene on
  * every platform with IEEE doubles).
- * RSA reaches about phi = 0.5 in 2D and 0.35 in 3D (less for wide size
- * ratios); beyond its limit the call fails with ODHS_E_TOODENSE and leaves the
+ * With the largest particles placed first RSA reaches about phi = 0.55-0.6 in
+ * 2D and 0.4-0.45 in 3D for a 1.4 bidisperse mixture (less for monodisperse
+ * particles); beyond its limit (2e6 failed attempts for one particle) the call fails with ODHS_E_TOODENSE and leaves the
  * system unchanged. Denser states are reached by compression (see stepper.h).
  */
 ODHS_API int odhs_system_place_random(odhs_system *sys, double phi, uint64_t seed);

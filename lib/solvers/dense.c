@@ -13,13 +13,24 @@ typedef struct {
     size_t *start, *inc; /* particle -> incident contacts */
     size_t icap, pcap;
     double info;    /* last LAPACK info */
+    double rcond;   /* reciprocal condition estimate of the last factor */
+    double min_rcond; /* below this N counts as singular */
 } dense_state;
 
 static int dense_create(void **state)
 {
     dense_state *s = odhs__calloc(1, sizeof *s);
     if (!s) return ODHS_E_NOMEM;
+    s->min_rcond = 1e-14;
     *state = s;
+    return ODHS_OK;
+}
+
+static int dense_set_param(void *state, const char *key, double v)
+{
+    dense_state *s = state;
+    if (!strcmp(key, "min_rcond") && v >= 0.0 && v < 1.0) s->min_rcond = v;
+    else return ODHS_E_INVALID;
     return ODHS_OK;
 }
 
@@ -88,10 +99,24 @@ static int dense_setup(void *state, const odhs_network *net)
             }
         }
     }
+    /* 1-norm of N (symmetric: lower triangle holds it all) for the condition
+     * estimate after the factorisation */
+    double anorm = 0.0;
+    for (size_t b = 0; b < nc; ++b) {
+        double col = 0.0;
+        for (size_t a = 0; a < nc; ++a) col += fabs(A[b * nc + a]);
+        anorm = fmax(anorm, col);
+    }
     lapack_int info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)nc, A, (lapack_int)nc);
     s->info = (double)info;
     if (info > 0) return ODHS_E_SINGULAR;
     if (info < 0) return ODHS_E_INTERNAL;
+    /* a hyperstatic network can factor with round-off pivots: reject it */
+    double rcond = 0.0;
+    info = LAPACKE_dpocon(LAPACK_COL_MAJOR, 'L', (lapack_int)nc, A, (lapack_int)nc, anorm, &rcond);
+    s->rcond = rcond;
+    if (info != 0) return ODHS_E_INTERNAL;
+    if (!(rcond > s->min_rcond)) return ODHS_E_SINGULAR;
     s->nc = nc;
     s->factored = 1;
     return ODHS_OK;
@@ -112,6 +137,7 @@ static int dense_get_stat(void *state, const char *key, double *v)
 {
     dense_state *s = state;
     if (!strcmp(key, "lapack_info")) *v = s->info;
+    else if (!strcmp(key, "rcond")) *v = s->rcond;
     else if (!strcmp(key, "iterations")) *v = 0.0;
     else return ODHS_E_INVALID;
     return ODHS_OK;
@@ -119,5 +145,5 @@ static int dense_get_stat(void *state, const char *key, double *v)
 
 const odhs_solver_type odhs_solver_type_dense = {
     ODHS_SOLVER_TYPE_VERSION, "dense", ODHS_SOLVER_DIRECT,
-    dense_create, dense_destroy, dense_setup, dense_solve, NULL, dense_get_stat,
+    dense_create, dense_destroy, dense_setup, dense_solve, dense_set_param, dense_get_stat,
 };
