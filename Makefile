@@ -383,10 +383,11 @@ examples-build: $(EXAMPLE_BINS)
 	@echo "examples: $(if $(EXAMPLE_BINS),built $(EXAMPLE_BINS),none in examples/)"
 
 # Only pkg-config output (plus an rpath to the stage) - no -Iinclude here.
+# -lm is the examples' own need (they call floor, ceil, ...), not libodhs's.
 build/examples/%: examples/%.c $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
 	@mkdir -p $(@D)
 	$(CC) $(CONSUMER_CFLAGS) -o $@ $< \
-	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) $(STAGE_RPATH)
+	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) -lm $(STAGE_RPATH)
 
 pkgconfig-test: stage
 	@$(MAKE) --no-print-directory pkgconfig-test-run

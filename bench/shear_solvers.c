@@ -92,7 +92,7 @@ int main(int argc, char **argv)
         }
         double tcg = 0.0;
         for (int s = 0; s < 2; ++s) {
-            if (s == 1 && n > 1024) continue; /* dense O(Nc^3) per solve */
+            if (s == 1 && n > 512) continue; /* dense O(Nc^3) per solve */
             odhs_system *sys;
             odhs_solver *sol;
             odhs_driver *drv;

@@ -2,7 +2,7 @@
  * target packing fraction, or until the contact network becomes potentially
  * jammed, with libodhs.
  *
- *     cc compress.c $(pkg-config --cflags --libs odhs) -o compress
+ *     cc compress.c $(pkg-config --cflags --libs odhs) -lm -o compress
  */
 #include <errno.h>
 #include <math.h>

@@ -6,7 +6,7 @@
  * stress, pressure, z and events to stdout.
  *
  * Build against an installed libodhs:
- *     cc shear_flow.c $(pkg-config --cflags --libs odhs) -o shear_flow
+ *     cc shear_flow.c $(pkg-config --cflags --libs odhs) -lm -o shear_flow
  */
 #include <errno.h>
 #include <math.h>

@@ -902,6 +902,21 @@ static size_t check_constrained(const odhs_network *net, size_t *ncon_out, int *
         /* the same in terms of zbar >= 2d */
         ck_assert_int_eq(flag, zn >= 2L * d * (long)nbar);
     }
+    /* rattlers: exactly the particles outside the constrained subset */
+    {
+        unsigned char *rat = malloc(n);
+        ck_assert_ptr_nonnull(rat);
+        memset(rat, 7, n);
+        size_t nrat = 12345;
+        ck_assert_int_eq(odhs_network_rattlers(net, rat, &nrat), ODHS_OK);
+        ck_assert_uint_eq(nrat, n - nbar);
+        for (size_t i = 0; i < n; ++i)
+            ck_assert_msg(rat[i] == !alive[i], "particle %zu: is_rattler = %d, in subset %d", i, rat[i], alive[i]);
+        ck_assert_int_eq(odhs_network_rattlers(net, NULL, &nrat), ODHS_OK);
+        ck_assert_uint_eq(nrat, n - nbar);
+        ck_assert_int_eq(odhs_network_rattlers(net, rat, NULL), ODHS_OK);
+        free(rat);
+    }
     if (ncon_out) *ncon_out = ncon;
     if (flag_out) *flag_out = flag;
     free(e);
@@ -933,6 +948,10 @@ START_TEST(test_constrained_triangle)
     ck_assert_int_eq(odhs_network_constrained(NULL, &nbar, NULL, NULL, NULL), ODHS_E_NULL);
     ck_assert_int_eq(odhs_network_potentially_jammed(NULL, &flag), ODHS_E_NULL);
     ck_assert_int_eq(odhs_network_potentially_jammed(net, NULL), ODHS_E_NULL);
+    size_t nr = 0;
+    ck_assert_int_eq(odhs_network_rattlers(NULL, in, &nr), ODHS_E_NULL);
+    ck_assert_int_eq(odhs_network_rattlers(net, in, &nr), ODHS_OK);
+    ck_assert_uint_eq(nr, 3); /* all three are rattlers */
     odhs_network_destroy(net);
     odhs_system_destroy(sys);
 }

@@ -476,6 +476,19 @@ START_TEST(test_setup_on_change)
         ck_assert(sv_reldiff(c2.nc, x, xd) < 1e-10);
         ck_assert_msg(sv_residual(c2.net, xd, b) < 1e-11, "dense after switching networks");
     }
+    /* contact forces are not part of the operator: no new setup */
+    {
+        double *f = malloc(c1.nc * sizeof *f);
+        ck_assert_ptr_nonnull(f);
+        for (size_t k = 0; k < c1.nc; ++k) f[k] = 0.5 + k;
+        ck_assert_int_eq(odhs_network_set_forces(c1.net, f), ODHS_OK);
+        ck_assert_int_eq(odhs_solver_solve(ge, c1.net, b, x), ODHS_OK);
+        ck_assert_int_eq(gs->setups, ++expect_setups); /* back from c2 */
+        ck_assert_int_eq(odhs_network_set_forces(c1.net, b), ODHS_OK);
+        ck_assert_int_eq(odhs_solver_solve(ge, c1.net, b, x), ODHS_OK);
+        ck_assert_int_eq(gs->setups, expect_setups);
+        free(f);
+    }
     /* geometry change of the same network: one particle moved a little */
     {
         double *pos = malloc(c1.n * 2 * sizeof *pos), *n0 = malloc(c1.nc * 2 * sizeof *n0),
@@ -910,6 +923,64 @@ START_TEST(test_recreated_network)
 }
 END_TEST
 
+/* The dense backend's reciprocal condition estimate against the exact
+ * 1-norm condition number of N (from an explicit inverse by GE), and its
+ * "min_rcond" threshold. */
+START_TEST(test_dense_rcond)
+{
+    sv_case c = sv_random_case(2, 80, 14, 4);
+    size_t nc = c.nc;
+    double *A = sv_dense_N(c.net), *Ainv = malloc(nc * nc * sizeof *Ainv), *e = calloc(nc, sizeof *e),
+           *col = malloc(nc * sizeof *col);
+    ck_assert(A && Ainv && e && col);
+    double anorm = 0.0, inorm = 0.0;
+    for (size_t j = 0; j < nc; ++j) {
+        double cs = 0.0;
+        for (size_t i = 0; i < nc; ++i) cs += fabs(A[i * nc + j]);
+        anorm = fmax(anorm, cs);
+        e[j] = 1.0;
+        ck_assert_int_eq(sv_gepp(nc, A, e, col), 0);
+        e[j] = 0.0;
+        cs = 0.0;
+        for (size_t i = 0; i < nc; ++i) cs += fabs(col[i]);
+        inorm = fmax(inorm, cs);
+    }
+    double rcond = 1.0 / (anorm * inorm);
+    double *b = malloc(nc * sizeof *b), *x = calloc(nc, sizeof *x);
+    ck_assert_ptr_nonnull(b);
+    for (size_t k = 0; k < nc; ++k) b[k] = 1.0;
+    odhs_solver *dn = sv_by_name("dense");
+    ck_assert_int_eq(odhs_solver_solve(dn, c.net, b, x), ODHS_OK);
+    double est = sv_stat(dn, "rcond");
+    /* the estimate of |N^-1|_1 never exceeds the true norm, and is close */
+    ck_assert_msg(est >= rcond * (1.0 - 1e-8) && est <= 10.0 * rcond, "rcond estimate %g, exact %g", est, rcond);
+    ck_assert_double_eq(sv_stat(dn, "lapack_info"), 0.0);
+    /* a threshold above the network's rcond: reported singular */
+    odhs_solver *strict = sv_by_name("dense");
+    ck_assert_int_eq(odhs_solver_set_param(strict, "min_rcond", fmin(0.9, 2.0 * est)), ODHS_OK);
+    memset(x, 0, nc * sizeof *x);
+    ck_assert_int_eq(odhs_solver_solve(strict, c.net, b, x), ODHS_E_SINGULAR);
+    ck_assert_str_ne(odhs_solver_errmsg(strict), "");
+    ck_assert_int_eq(odhs_solver_set_param(strict, "min_rcond", 0.5 * est), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_solve(strict, c.net, b, x), ODHS_OK);
+    ck_assert(sv_residual(c.net, x, b) < 1e-11);
+    /* validation */
+    ck_assert_int_eq(odhs_solver_set_param(strict, "min_rcond", -1e-3), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(strict, "min_rcond", 1.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(strict, "min_rcond", NAN), ODHS_E_NONFINITE);
+    ck_assert_int_eq(odhs_solver_set_param(strict, "min_rcond", 0.0), ODHS_OK);
+    free(A);
+    free(Ainv);
+    free(e);
+    free(col);
+    free(b);
+    free(x);
+    odhs_solver_destroy(dn);
+    odhs_solver_destroy(strict);
+    sv_case_free(&c);
+}
+END_TEST
+
 /* ------------------------------------------------------------------------ */
 /* singular N                                                                */
 /* ------------------------------------------------------------------------ */
@@ -1101,6 +1172,7 @@ Suite *make_solver_suite(void)
     tcase_add_test(tc, test_create_by_name);
     tcase_add_test(tc, test_cg_params_stats);
     tcase_add_test(tc, test_residual_stat_after_failure);
+    tcase_add_test(tc, test_dense_rcond);
     tcase_add_test(tc, test_null_and_empty);
     suite_add_tcase(s, tc);
 
