@@ -378,6 +378,7 @@ stage: all
 
 examples: stage
 	@$(MAKE) --no-print-directory examples-build pkgconfig-test-run
+	bash tests/examples_cli.sh build/examples
 
 examples-build: $(EXAMPLE_BINS)
 	@echo "examples: $(if $(EXAMPLE_BINS),built $(EXAMPLE_BINS),none in examples/)"

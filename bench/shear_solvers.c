@@ -58,7 +58,7 @@ static odhs_system *scene(size_t n, unsigned seed)
     if (odhs_system_create(2, n, &sys) || odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed) ||
         odhs_system_place_random(sys, 0.45, seed + 1))
         return NULL;
-    odhs_solver_create_by_name("dense", &cg);
+    odhs_solver_create_by_name("cg", &cg);
     odhs_driver_create(&drv);
     odhs_driver_set_compression_rate(drv, 1.0);
     odhs_stepper_create(sys, drv, cg, &st);

@@ -23,7 +23,8 @@ static void usage(FILE *f)
             "  --series FILE.csv  write phi,pressure,z,events per output interval\n"
             "  --every X          output interval in packing fraction (default 0.01)\n"
             "  --dt X             step in units of 1/rate (default 1e-3)\n"
-            "  --solver NAME      linear solver: cg, dense (default cg)\n"
+            "  --solver NAME      linear solver: cg, dense (default: dense up to N = 2000,\n"
+            "                     cg above; CG stalls close to jamming)\n"
             "  --n N              built-in scene: number of particles (default 256)\n"
             "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
             "  --seed S           built-in scene: random seed (default 1)\n"
@@ -54,7 +55,7 @@ static int parse_ulong(const char *s, unsigned long *out)
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *solver_name = "cg";
+    const char *in = NULL, *outpath = NULL, *series = NULL, *solver_name = NULL;
     double phi_target = 0.80, every = 0.01, dt = 1e-3;
     unsigned long n = 256, seed = 1, dim = 2;
     int jam = 0;
@@ -98,13 +99,8 @@ int main(int argc, char **argv)
     }
     if (jam) phi_target = 0.999;
 
-    odhs_solver *solver;
-    int rc = odhs_solver_create_by_name(solver_name, &solver);
-    if (rc) {
-        fprintf(stderr, "compress: solver %s: %s\n", solver_name, odhs_strerror(rc));
-        return 2;
-    }
     odhs_system *sys = NULL;
+    int rc;
     if (in) {
         char err[512];
         rc = odhs_xyz_read(in, &sys, err, sizeof err);
@@ -119,6 +115,13 @@ int main(int argc, char **argv)
             fprintf(stderr, "compress: building the scene: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
             return 1;
         }
+    }
+    if (!solver_name) solver_name = odhs_system_count(sys) <= 2000 ? "dense" : "cg";
+    odhs_solver *solver;
+    rc = odhs_solver_create_by_name(solver_name, &solver);
+    if (rc) {
+        fprintf(stderr, "compress: solver %s: %s\n", solver_name, odhs_strerror(rc));
+        return 2;
     }
     double phi;
     odhs_system_packing_fraction(sys, &phi);
