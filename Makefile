@@ -378,6 +378,7 @@ stage: all
 
 examples: stage
 	@$(MAKE) --no-print-directory examples-build pkgconfig-test-run
+	bash tests/docs_samples.sh build/stage
 	bash tests/examples_cli.sh build/examples
 
 examples-build: $(EXAMPLE_BINS)

@@ -121,21 +121,32 @@ static uint64_t net_checksum(const odhs_network *net)
     return h ^ net->nc;
 }
 
-int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse)
+/* The one solve path: b given (N x = b), or g given (least squares on S^T,
+ * b = S g). Sets up the backend when needed and checks the result. */
+static int solve_any(odhs_solver *s, const odhs_network *net, const double *b, const double *g, double *x,
+                     int reuse)
 {
     if (!s) return ODHS_E_NULL;
     if (!net) return solerr(s, ODHS_E_NULL, "network is NULL");
-    size_t nc = net->nc;
+    size_t nc = net->nc, nd = net->n * (size_t)net->dim;
     if (nc == 0) return ODHS_OK;
-    if (!b || !x) return solerr(s, ODHS_E_NULL, "vector pointer is NULL");
-    for (size_t c = 0; c < nc; ++c)
-        if (!isfinite(b[c])) return solerr(s, ODHS_E_NONFINITE, "right-hand side entry %zu is not finite", c);
-    size_t need = nc + net->n * (size_t)net->dim;
+    if ((!b && !g) || !x) return solerr(s, ODHS_E_NULL, "vector pointer is NULL");
+    size_t need = 2 * nc + nd;
     if (s->work_cap < need) {
         double *w = odhs__realloc(s->work, need * sizeof *w);
         if (!w) return solerr(s, ODHS_E_NOMEM, "out of memory");
         s->work = w;
         s->work_cap = need;
+    }
+    double *Nx = s->work, *tmp = s->work + nc, *bg = s->work + nc + nd;
+    if (g) {
+        for (size_t k = 0; k < nd; ++k)
+            if (!isfinite(g[k])) return solerr(s, ODHS_E_NONFINITE, "right-hand side entry %zu is not finite", k);
+        odhs__net_S(net, g, bg);
+        b = bg;
+    } else {
+        for (size_t c = 0; c < nc; ++c)
+            if (!isfinite(b[c])) return solerr(s, ODHS_E_NONFINITE, "right-hand side entry %zu is not finite", c);
     }
     int st;
     uint64_t sum = (reuse || !s->type->setup) ? 0 : net_checksum(net);
@@ -153,10 +164,10 @@ int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b,
         s->last_sum = sum;
     }
     if (!(s->type->flags & ODHS_SOLVER_USES_GUESS)) memset(x, 0, nc * sizeof *x);
-    st = s->type->solve(s->state, net, b, x);
+    if (g && s->type->version >= 2 && s->type->solve_ls) st = s->type->solve_ls(s->state, net, g, x);
+    else st = s->type->solve(s->state, net, b, x);
     s->nsolves += 1.0;
     /* check the result: finite, small residual (also recorded after a failure) */
-    double *Nx = s->work, *tmp = s->work + nc;
     for (size_t c = 0; c < nc; ++c)
         if (!isfinite(x[c])) {
             s->last_residual = INFINITY;
@@ -180,4 +191,15 @@ int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b,
                       s->check_tol);
     }
     return ODHS_OK;
+}
+
+int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse)
+{
+    return solve_any(s, net, b, NULL, x, reuse);
+}
+
+int odhs_solver_solve_ls(odhs_solver *s, const odhs_network *net, const double *g, double *x)
+{
+    if (s && !g) return solerr(s, ODHS_E_NULL, "vector pointer is NULL");
+    return solve_any(s, net, NULL, g, x, 0);
 }

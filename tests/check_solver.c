@@ -308,19 +308,24 @@ static int ge_get_stat(void *state, const char *key, double *v)
     return ODHS_OK;
 }
 
+/* Version-1 tables (written before solve_ls existed) must keep working:
+ * designated initializers leave the newer fields NULL. */
 static const odhs_solver_type ge_type = {
-    ODHS_SOLVER_TYPE_VERSION, "user-gepp", ODHS_SOLVER_DIRECT,
-    ge_create, ge_destroy, ge_setup, ge_solve, ge_set_param, ge_get_stat,
+    .version = 1, .name = "user-gepp", .flags = ODHS_SOLVER_DIRECT, .create = ge_create,
+    .destroy = ge_destroy, .setup = ge_setup, .solve = ge_solve, .set_param = ge_set_param,
+    .get_stat = ge_get_stat,
 };
 
 static const odhs_solver_type ge_type_iterative = {
-    ODHS_SOLVER_TYPE_VERSION, "user-gepp-it", ODHS_SOLVER_ITERATIVE,
-    ge_create, ge_destroy, ge_setup, ge_solve, ge_set_param, ge_get_stat,
+    .version = 1, .name = "user-gepp-it", .flags = ODHS_SOLVER_ITERATIVE, .create = ge_create,
+    .destroy = ge_destroy, .setup = ge_setup, .solve = ge_solve, .set_param = ge_set_param,
+    .get_stat = ge_get_stat,
 };
 
-/* only the required entries */
+/* only the required entries, current version */
 static const odhs_solver_type ge_type_min = {
-    ODHS_SOLVER_TYPE_VERSION, "user-min", 0u, ge_create, ge_destroy, NULL, ge_solve_nosetup, NULL, NULL,
+    .version = ODHS_SOLVER_TYPE_VERSION, .name = "user-min", .flags = 0u, .create = ge_create,
+    .destroy = ge_destroy, .solve = ge_solve_nosetup,
 };
 
 static int failing_create(void **state)

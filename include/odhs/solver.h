@@ -15,17 +15,22 @@
 extern "C" {
 #endif
 
-/** Version of odhs_solver_type understood by this library. */
-#define ODHS_SOLVER_TYPE_VERSION 1
+/** Version of odhs_solver_type understood by this library. Tables of an
+ *  older version are accepted: the fields they lack count as NULL. */
+#define ODHS_SOLVER_TYPE_VERSION 2
 
 /* capability flags */
 #define ODHS_SOLVER_ITERATIVE 0x1u /* result depends on a tolerance          */
 #define ODHS_SOLVER_DIRECT 0x2u    /* factorisation-based                     */
 #define ODHS_SOLVER_USES_GUESS 0x4u /* uses x on input as initial guess       */
+#define ODHS_SOLVER_LEAST_SQUARES 0x8u /* solves on S^T without forming N   */
 
 /**
  * A solver backend. Required: version, name, create, destroy, solve. Optional
- * (may be NULL; the library supplies defaults): setup, set_param, get_stat.
+ * (may be NULL; the library supplies defaults): setup, set_param, get_stat,
+ * solve_ls. Fill it with designated initializers (.name = ...) so that fields
+ * appended in later versions stay NULL; a table declaring an older version is
+ * read only up to that version's fields.
  * Functions return ODHS_OK or an error code (ODHS_E_SINGULAR, ODHS_E_NOCONV,
  * ODHS_E_NOMEM, ...).
  */
@@ -48,6 +53,11 @@ typedef struct odhs_solver_type {
     int (*set_param)(void *state, const char *key, double value);
     /** Get a named statistic of the last solve (e.g. "iterations"). */
     int (*get_stat)(void *state, const char *key, double *value);
+    /* ---- version >= 2 ---- */
+    /** Optional: the least-squares solution x of S^T x = g (g of length
+     *  N*dim), i.e. N x = S g without forming N (better conditioned). The
+     *  library supplies b = S g and calls solve when this is NULL. */
+    int (*solve_ls)(void *state, const odhs_network *net, const double *g, double *x);
 } odhs_solver_type;
 
 /** Preconditioned (Jacobi) conjugate gradient, matrix-free on S S^T.
@@ -95,6 +105,13 @@ ODHS_API int odhs_solver_set_check_tolerance(odhs_solver *s, double tol);
  * recorded even when the solve fails.
  */
 ODHS_API int odhs_solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x);
+/**
+ * Least-squares contact forces: x minimising |S^T x - g| (g has N*dim
+ * entries), the same x as N x = S g. Uses the backend's solve_ls when it has
+ * one (no squared condition number), otherwise forms b = S g and solves.
+ * The "residual" statistic is that of N x = S g.
+ */
+ODHS_API int odhs_solver_solve_ls(odhs_solver *s, const odhs_network *net, const double *g, double *x);
 
 #ifdef __cplusplus
 }

@@ -120,5 +120,5 @@ static int cg_solve(void *state, const odhs_network *net, const double *b, doubl
 
 const odhs_solver_type odhs_solver_type_cg = {
     ODHS_SOLVER_TYPE_VERSION, "cg", ODHS_SOLVER_ITERATIVE | ODHS_SOLVER_USES_GUESS,
-    cg_create, cg_destroy, NULL, cg_solve, cg_set_param, cg_get_stat,
+    cg_create, cg_destroy, NULL, cg_solve, cg_set_param, cg_get_stat, NULL,
 };

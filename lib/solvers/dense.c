@@ -145,5 +145,5 @@ static int dense_get_stat(void *state, const char *key, double *v)
 
 const odhs_solver_type odhs_solver_type_dense = {
     ODHS_SOLVER_TYPE_VERSION, "dense", ODHS_SOLVER_DIRECT,
-    dense_create, dense_destroy, dense_setup, dense_solve, dense_set_param, dense_get_stat,
+    dense_create, dense_destroy, dense_setup, dense_solve, dense_set_param, dense_get_stat, NULL,
 };
