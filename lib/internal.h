@@ -101,6 +101,7 @@ struct odhs_network {
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
+odhs_network *odhs__net_new(int dim, size_t n);
 int odhs__neterr(const odhs_network *net, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
 /* index of (i,j) (i<j) or SIZE_MAX */
 size_t odhs__net_find(const odhs_network *net, size_t i, size_t j);
@@ -137,6 +138,7 @@ struct odhs_solver {
  * whenever the backend has a setup. */
 int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse);
 void odhs__solver_invalidate(odhs_solver *s);
+int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);
 
 /* ---- driver ---------------------------------------------------------------- */
 struct odhs_driver {

@@ -76,21 +76,26 @@ static int grow(odhs_network *net)
     return ODHS_OK;
 }
 
+odhs_network *odhs__net_new(int dim, size_t n)
+{
+    odhs_network *net = odhs__calloc(1, sizeof *net);
+    if (!net) return NULL;
+    net->dim = dim;
+    net->n = n;
+    if (grow(net)) {
+        odhs_network_destroy(net);
+        return NULL;
+    }
+    return net;
+}
+
 int odhs_network_create(const odhs_system *sys, odhs_network **out)
 {
     if (!out) return ODHS_E_NULL;
     *out = NULL;
     if (!sys) return ODHS_E_NULL;
-    odhs_network *net = odhs__calloc(1, sizeof *net);
-    if (!net) return ODHS_E_NOMEM;
-    net->dim = sys->dim;
-    net->n = sys->n;
-    if (grow(net)) {
-        odhs_network_destroy(net);
-        return ODHS_E_NOMEM;
-    }
-    *out = net;
-    return ODHS_OK;
+    *out = odhs__net_new(sys->dim, sys->n);
+    return *out ? ODHS_OK : ODHS_E_NOMEM;
 }
 
 void odhs_network_destroy(odhs_network *net)

@@ -240,7 +240,20 @@ static int rewire(odhs_stepper *st)
     for (;;) {
         if (++it > maxit)
             return sterr(st, ODHS_E_REWIRE, "rewiring did not terminate after %zu iterations", maxit);
-        if ((s = compute_forces(st))) return s;
+        /* Sect. IV D: on a potentially jammed network N is singular and the
+         * self-stress f0 plays the part of the forces */
+        int pj = 0;
+        if ((s = odhs_network_potentially_jammed(net, &pj))) return sterr(st, s, "%s", net->errmsg);
+        if (pj && st->drv->pressure_on)
+            return sterr(st, ODHS_POTENTIALLY_JAMMED,
+                         "potentially jammed under fixed pressure at t = %.17g (not handled yet)", st->time);
+        if (pj) {
+            if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
+                return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED,
+                             "potentially jammed at t = %.17g: %s", st->time, net->errmsg);
+        } else if ((s = compute_forces(st))) {
+            return s;
+        }
         double fmax = 0.0, fmin = 0.0;
         size_t kmin = SIZE_MAX;
         for (size_t c = 0; c < net->nc; ++c) {
@@ -260,6 +273,18 @@ static int rewire(odhs_stepper *st)
             odhs__net_remove_at(net, kmin);
             if (record_change(st, i, j, -1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
             continue;
+        }
+        if (pj) {
+            /* positive self-stress: jammed. Forces = f0 scaled to unit
+             * pressure; nothing can move under this driving. */
+            double fr = 0.0, vol;
+            for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
+            odhs_system_volume(st->sys, &vol);
+            double scale = vol * st->dim / fr;
+            for (size_t c = 0; c < net->nc; ++c) net->f[c] *= scale;
+            memset(st->U, 0, st->nd * sizeof *st->U);
+            st->jammed = 1;
+            return ODHS_OK;
         }
         compute_velocities(st);
         if (st->nrem == 0) break;
@@ -607,14 +632,6 @@ static int check_driver(odhs_stepper *st)
     return ODHS_OK;
 }
 
-static int check_jammed(odhs_stepper *st)
-{
-    int flag = 0;
-    int s = odhs_network_potentially_jammed(st->net, &flag);
-    if (s) return sterr(st, s, "%s", odhs_network_errmsg(st->net));
-    st->jammed = flag;
-    return ODHS_OK;
-}
 
 int odhs_stepper_reset(odhs_stepper *st)
 {
@@ -636,8 +653,6 @@ int odhs_stepper_reset(odhs_stepper *st)
     if ((s = odhs_network_detect(net, st->sys, st->contact_tol))) return sterr(st, s, "%s", net->errmsg);
     if ((s = build_neighbours(st))) return s;
     if ((s = eval_forces(st))) return s;
-    if ((s = check_jammed(st))) return s;
-    if (st->jammed) return sterr(st, ODHS_POTENTIALLY_JAMMED, "the initial network is potentially jammed");
     st->nchg = 0;
     if ((s = rewire(st))) return s;
     st->nchg = 0;
@@ -667,6 +682,9 @@ static int correct(odhs_stepper *st, int *added)
             gmax = fmax(gmax, fabs(net->gap[c]) / (sys->r[net->ci[c]] + sys->r[net->cj[c]]));
         if (gmax <= 4e-16) return ODHS_OK;            /* at round-off */
         if (!(gmax < 0.5 * prev)) return ODHS_OK;     /* no further progress */
+        int isostatic = 0;
+        if ((s = odhs_network_potentially_jammed(net, &isostatic))) return sterr(st, s, "%s", net->errmsg);
+        if (isostatic) return ODHS_OK; /* N singular: the rewiring handles it (f0) */
         prev = gmax;
         memset(st->cx, 0, nc * sizeof *st->cx);
         if ((s = solve(st, net->gap, st->cx))) return s;
@@ -679,11 +697,6 @@ static int correct(odhs_stepper *st, int *added)
             size_t c = odhs__net_add(net, pi, pj, ODHS_CONTACT_TEMPORARY);
             if (c == SIZE_MAX || record_change(st, pi, pj, +1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
             *added = 1;
-            if ((s = check_jammed(st))) return s;
-            if (st->jammed) {
-                odhs__net_geometry(net, sys);
-                return ODHS_OK;
-            }
             prev = INFINITY; /* new contact: a new problem */
         }
     }
@@ -738,9 +751,7 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
         first->kind = ODHS_EVENT_NONE;
     }
     if (!st->ready && (s = odhs_stepper_reset(st))) return s;
-    if (st->jammed)
-        return sterr(st, ODHS_POTENTIALLY_JAMMED,
-                     "the network is potentially jammed (N = S S^T singular): no further steps");
+    if (st->jammed) return sterr(st, ODHS_JAMMED, "the packing is jammed: no further steps under this driving");
     if ((s = snapshot(st))) return s;
     st->nchg = 0;
     if (st->drv_version != st->drv->version) {
@@ -789,21 +800,16 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     }
     odhs__net_geometry(net, st->sys);
     if ((s = eval_forces(st))) goto fail;
-    if (ci != SIZE_MAX) {
-        if ((s = check_jammed(st))) goto fail;
-    }
-    if (!st->jammed) {
+    if ((s = rewire(st))) goto fail;
+    if (!st->jammed && st->corr_every && st->nsteps % st->corr_every == 0) {
+        int added = 0;
+        if ((s = correct(st, &added))) goto fail;
         if ((s = rewire(st))) goto fail;
-        if (st->corr_every && st->nsteps % st->corr_every == 0) {
-            int added = 0;
-            if ((s = correct(st, &added))) goto fail;
-            if (!st->jammed && (s = rewire(st))) goto fail;
-        }
     }
     if ((s = emit_events(st, first, stop))) goto fail;
     if (st->jammed)
-        return sterr(st, ODHS_POTENTIALLY_JAMMED,
-                     "potentially jammed at t = %.17g: the constrained subset became isostatic", st->time);
+        return sterr(st, ODHS_JAMMED, "jammed at t = %.17g: isostatic constrained subset, positive self-stress",
+                     st->time);
     return ODHS_OK;
 fail:
     rollback(st);
@@ -831,13 +837,12 @@ int odhs_stepper_correct(odhs_stepper *st)
     if (!st) return ODHS_E_NULL;
     int s, stop = 0, added = 0;
     if (!st->ready && (s = odhs_stepper_reset(st))) return s;
-    if (st->jammed) return sterr(st, ODHS_POTENTIALLY_JAMMED, "the network is potentially jammed");
     if ((s = snapshot(st))) return s;
     st->nchg = 0;
     if ((s = correct(st, &added))) goto fail;
-    if (!st->jammed && (s = rewire(st))) goto fail;
+    if ((s = rewire(st))) goto fail;
     if ((s = emit_events(st, NULL, &stop))) goto fail;
-    if (st->jammed) return ODHS_POTENTIALLY_JAMMED;
+    if (st->jammed) return ODHS_JAMMED;
     return stop ? ODHS_STOPPED : ODHS_OK;
 fail:
     rollback(st);

@@ -14,6 +14,7 @@ const char *odhs_strerror(int status)
     case ODHS_OK: return "success";
     case ODHS_STOPPED: return "stopped by a user callback";
     case ODHS_POTENTIALLY_JAMMED: return "potentially jammed: the constrained subset is isostatic";
+    case ODHS_JAMMED: return "jammed: isostatic constrained subset with positive self-stress";
     case ODHS_E_NULL: return "a required pointer argument is NULL";
     case ODHS_E_INVALID: return "invalid argument";
     case ODHS_E_NOMEM: return "out of memory";

@@ -52,8 +52,13 @@ enum {
 
     /* warnings / informative stops (> 0) */
     ODHS_STOPPED = 1,          /* a user callback asked to stop the run      */
-    ODHS_POTENTIALLY_JAMMED = 2, /* constrained subset reached isostaticity:
-                                  N = S S^T is singular; the run stopped     */
+    ODHS_POTENTIALLY_JAMMED = 2, /* constrained subset isostatic and its
+                                  self-stress f0 could not be used (fixed
+                                  pressure, or f0 not computable); the run
+                                  stopped                                    */
+    ODHS_JAMMED = 3,           /* jammed: the constrained subset is isostatic
+                                  and its self-stress f0 is positive; the
+                                  run stopped (Sect. IV D)                   */
 
     /* errors (< 0) */
     ODHS_E_NULL = -1,          /* a required pointer argument was NULL       */

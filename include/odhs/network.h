@@ -114,6 +114,24 @@ ODHS_API int odhs_network_rattlers(const odhs_network *net, unsigned char *is_ra
  */
 ODHS_API int odhs_network_potentially_jammed(const odhs_network *net, int *flag);
 
+struct odhs_solver; /* see solver.h */
+
+/**
+ * The self-stress f0 of a potentially jammed network (Sect. IV D): the nonzero
+ * solution of S^T f0 = 0 on the constrained subset (zero on every other
+ * contact), with the sign fixed so that sum f0 > 0 and scaled to mean 1 over
+ * the subset's contacts. f0 has Nc entries. The network must be potentially
+ * jammed (else ODHS_E_STATE). Method: with solver == NULL, or a subset of at
+ * most 600 contacts, the eigenvector of the smallest eigenvalue of N on the
+ * subset (LAPACK dsyevr); otherwise one contact k is fixed to f0_k = 1 and the
+ * rest solve S'^T y = -s_k^T in the least-squares sense with the solver on the
+ * remaining contacts (other k are tried if that network is singular).
+ * *residual (may be NULL) receives max_i |(S^T f0)_i| / mean f0.
+ * ODHS_E_SINGULAR when the kernel is not one-dimensional.
+ */
+ODHS_API int odhs_network_null_vector(const odhs_network *net, struct odhs_solver *solver, double *f0,
+                                      double *residual);
+
 #ifdef __cplusplus
 }
 #endif

@@ -71,7 +71,7 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cg;
  *  networks. Statistics: "rcond", "lapack_info". O(Nc^3) per setup. */
 ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
 
-typedef struct odhs_solver odhs_solver;
+typedef struct odhs_solver odhs_solver; /* struct tag declared in network.h */
 
 /** Create a solver handle for a backend type (user or built-in). The table
  *  must outlive the handle. ODHS_E_INVALID for a malformed table. */
