@@ -158,8 +158,13 @@ int main(int argc, char **argv)
         printf("%10.6f %14.6e %8.4f %10llu\n", phi, p, z, (unsigned long long)(nc + no));
         if (csv) fprintf(csv, "%.12g,%.10g,%.6f,%llu\n", phi, p, z, (unsigned long long)(nc + no));
         fprintf(stderr, "\rcompress: phi %.5f", phi);
+        if (rc == ODHS_JAMMED) {
+            fprintf(stderr, "\ncompress: jammed at phi = %.12f (z = %.4f; pressure normalised to 1)\n", phi, z);
+            break;
+        }
         if (rc == ODHS_POTENTIALLY_JAMMED) {
-            fprintf(stderr, "\ncompress: potentially jammed at phi = %.10f (z = %.4f)\n", phi, z);
+            fprintf(stderr, "\ncompress: potentially jammed at phi = %.10f (z = %.4f): %s\n", phi, z,
+                    odhs_stepper_errmsg(st));
             break;
         }
         if (rc) {
@@ -172,7 +177,7 @@ int main(int argc, char **argv)
             break;
         }
     }
-    if (!status) {
+    if (!status && rc != ODHS_JAMMED) {
         rc = odhs_stepper_correct(st);
         if (rc < 0) fprintf(stderr, "compress: final correction: %s\n", odhs_stepper_errmsg(st));
     }

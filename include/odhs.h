@@ -12,5 +12,6 @@
 #include "odhs/solver.h"
 #include "odhs/driver.h"
 #include "odhs/stepper.h"
+#include "odhs/jamming.h"
 
 #endif /* ODHS_H */

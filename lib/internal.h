@@ -138,6 +138,7 @@ struct odhs_solver {
  * whenever the backend has a setup. */
 int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse);
 void odhs__solver_invalidate(odhs_solver *s);
+int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, const double *f0);
 int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);
 
 /* ---- driver ---------------------------------------------------------------- */

@@ -2,6 +2,7 @@
  * (Sect. IV D of Lerner, During & Wyart 2013). */
 #include <lapacke.h>
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "internal.h"
@@ -60,11 +61,11 @@ static int null_dense(const odhs_network *net, const size_t *idx, size_t m, doub
             if (net->cj[ca] == net->cj[cb]) v += dot;
             if (net->ci[ca] == net->cj[cb]) v -= dot;
             if (net->cj[ca] == net->ci[cb]) v -= dot;
-            A[b * m + a] = v; /* lower triangle, column-major */
+            A[b * m + a] = v; /* (row a, column b), a <= b: upper triangle, column-major */
         }
     lapack_int found = 0;
     lapack_int mm = (lapack_int)m, iu = m >= 2 ? 2 : 1;
-    lapack_int info = LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', mm, A, mm, 0.0, 0.0, 1, iu, 0.0, &found,
+    lapack_int info = LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'U', mm, A, mm, 0.0, 0.0, 1, iu, 0.0, &found,
                                      w, z, mm, supp);
     int st = ODHS_OK;
     if (info != 0 || found < 1) st = ODHS_E_INTERNAL;
@@ -174,4 +175,204 @@ int odhs_network_null_vector(const odhs_network *net, odhs_solver *solver, doubl
     if (!net) return ODHS_E_NULL;
     if (!f0 && net->nc) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
     return odhs__null_vector(net, solver, f0, residual);
+}
+
+/* ---- polishing a jammed packing ------------------------------------------ */
+/* Contact gaps to round-off on an isostatic network with self-stress f0: the
+ * gap component along f0 cannot be removed by moving particles (S dR is
+ * orthogonal to f0), but an isotropic rescaling changes every gap by -eps*r:
+ * eps = <f0|gap>/<f0|r>. The remaining gaps are in the range of S and are
+ * removed by dR = -S'^T N'^-1 gap' on the network without one contact k
+ * (f0_k != 0): the rows of S are dependent only through f0, so row k follows. */
+int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, const double *f0)
+{
+    int d = net->dim, st = ODHS_OK;
+    size_t nc = net->nc, nd = net->n * (size_t)d;
+    if (nc == 0) return ODHS_OK;
+    size_t k = 0;
+    for (size_t c = 1; c < nc; ++c)
+        if (fabs(f0[c]) > fabs(f0[k])) k = c;
+    odhs_network *sub = odhs__net_new(d, net->n);
+    double *y = odhs__calloc(nc, sizeof *y), *dR = odhs__calloc(nd, sizeof *dR);
+    size_t *map = odhs__malloc_array(nc, sizeof *map);
+    if (!sub || !y || !dR || !map) {
+        st = ODHS_E_NOMEM;
+        goto done;
+    }
+    for (size_t c = 0; c < nc; ++c) {
+        if (c == k) continue;
+        map[sub->nc] = c;
+        if (odhs__net_add(sub, net->ci[c], net->cj[c], net->kind[c]) == SIZE_MAX) {
+            st = ODHS_E_NOMEM;
+            goto done;
+        }
+    }
+    double prev = INFINITY;
+    for (int pass = 0; pass < 12; ++pass) {
+        odhs__net_geometry(net, sys);
+        double gmax = 0.0, fg = 0.0, fr = 0.0;
+        for (size_t c = 0; c < nc; ++c) {
+            gmax = fmax(gmax, fabs(net->gap[c]) / (sys->r[net->ci[c]] + sys->r[net->cj[c]]));
+            fg += f0[c] * net->gap[c];
+            fr += f0[c] * net->dist[c];
+        }
+        if (gmax <= 2e-16 || !(gmax < 0.5 * prev)) break;
+        prev = gmax;
+        /* affine part: rescale box and positions about the origin */
+        double s = 1.0 - fg / fr;
+        for (int a = 0; a < d; ++a) sys->L[a] *= s;
+        for (size_t q = 0; q < nd; ++q) sys->x[q] *= s;
+        odhs__net_geometry(net, sys);
+        /* non-affine part on the reduced network */
+        odhs__net_geometry(sub, sys);
+        double *gap = odhs__malloc_array(sub->nc ? sub->nc : 1, sizeof *gap);
+        if (!gap) {
+            st = ODHS_E_NOMEM;
+            goto done;
+        }
+        for (size_t c = 0; c < sub->nc; ++c) gap[c] = sub->gap[c];
+        memset(y, 0, nc * sizeof *y);
+        st = odhs_solver_solve(sol, sub, gap, y);
+        odhs__free(gap);
+        if (st) goto done;
+        odhs__net_ST(sub, y, dR);
+        for (size_t q = 0; q < nd; ++q) sys->x[q] -= dR[q];
+        for (size_t i = 0; i < net->n; ++i) odhs__wrap(d, sys->L, sys->gamma, sys->x + i * d);
+    }
+    odhs__net_geometry(net, sys);
+done:
+    (void)map;
+    odhs_network_destroy(sub);
+    odhs__free(y);
+    odhs__free(dR);
+    odhs__free(map);
+    return st;
+}
+
+/* ---- certificate ---------------------------------------------------------- */
+typedef struct {
+    const odhs_network *net;
+    const double *r;
+    double worst;
+} cert_ov_ctx;
+
+static int cert_ov_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    cert_ov_ctx *c = vctx;
+    if (odhs__net_find(c->net, i, j) != SIZE_MAX) return 0;
+    double rel = -gap / (c->r[i] + c->r[j]);
+    if (rel > c->worst) c->worst = rel;
+    return 0;
+}
+
+int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!cert) return odhs__neterr(st->net, ODHS_E_NULL, "certificate pointer is NULL");
+    if (cert->size < sizeof(size_t)) return ODHS_E_INVALID;
+    const odhs_system *sys = st->sys;
+    const odhs_network *net = st->net;
+    odhs_jam_certificate c;
+    memset(&c, 0, sizeof c);
+    c.size = cert->size < sizeof c ? cert->size : sizeof c;
+    int d = net->dim, s;
+    size_t n = net->n, nd = n * (size_t)d;
+    unsigned char *in = odhs__malloc_array(n, 1);
+    double *F = odhs__calloc(nd, sizeof *F);
+    if (!in || !F) {
+        odhs__free(in);
+        odhs__free(F);
+        return ODHS_E_NOMEM;
+    }
+    size_t nbar = 0, ncon = 0;
+    if ((s = odhs_network_constrained(net, &nbar, &ncon, in, NULL))) {
+        odhs__free(in);
+        odhs__free(F);
+        return s;
+    }
+    c.jammed = st->jammed;
+    odhs_system_packing_fraction(sys, &c.phi);
+    c.n_particles = n;
+    c.n_backbone = nbar;
+    c.n_rattlers = n - nbar;
+    c.n_contacts = net->nc;
+    c.n_contacts_backbone = ncon;
+    c.n_contacts_isostatic = nbar ? (size_t)d * (nbar - 1) + 1 : 0;
+    c.isostatic = nbar > 0 && ncon == c.n_contacts_isostatic;
+    c.z = 2.0 * (double)net->nc / (double)n;
+    c.z_backbone = nbar ? 2.0 * (double)ncon / (double)nbar : 0.0;
+    double vol, fr = 0.0, fsum = 0.0, fmin = INFINITY;
+    odhs_system_volume(sys, &vol);
+    for (size_t k = 0; k < net->nc; ++k) {
+        fr += net->f[k] * net->dist[k];
+        c.gap_error = fmax(c.gap_error, fabs(net->gap[k]) / (sys->r[net->ci[k]] + sys->r[net->cj[k]]));
+        if (in[net->ci[k]] && in[net->cj[k]]) {
+            fsum += net->f[k];
+            fmin = fmin < net->f[k] ? fmin : net->f[k];
+        }
+    }
+    c.pressure = fr / (vol * d);
+    double fmean = ncon ? fsum / (double)ncon : 1.0;
+    c.min_force = ncon ? fmin / fmean : 0.0;
+    odhs__net_ST(net, net->f, F);
+    for (size_t i = 0; i < n; ++i) {
+        if (!in[i]) continue;
+        double s2 = 0.0;
+        for (int a = 0; a < d; ++a) s2 += F[i * d + a] * F[i * d + a];
+        c.force_balance = fmax(c.force_balance, sqrt(s2) / fabs(fmean));
+    }
+    cert_ov_ctx oc = {net, sys->r, 0.0};
+    s = odhs__pairs(d, n, sys->x, sys->r, sys->rmax, sys->L, sys->gamma, 0.0, cert_ov_cb, &oc);
+    c.overlap = oc.worst;
+    odhs__free(in);
+    odhs__free(F);
+    if (s == ODHS_E_NOMEM) return s;
+    memcpy(cert, &c, c.size);
+    return ODHS_OK;
+}
+
+/* ---- contacts file -------------------------------------------------------- */
+int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const char *path)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!sys || !path) return odhs__neterr(net, ODHS_E_NULL, "NULL argument");
+    if (sys->n != net->n || sys->dim != net->dim)
+        return odhs__neterr(net, ODHS_E_DIM, "system and network differ in N or dimension");
+    if (!sys->has_x || !sys->has_r) return odhs__neterr(net, ODHS_E_STATE, "system radii and positions unset");
+    size_t len = strlen(path);
+    char *tmp = odhs__malloc(len + 32);
+    if (!tmp) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    snprintf(tmp, len + 32, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        int e = odhs__neterr(net, ODHS_E_IO, "cannot write %s", tmp);
+        odhs__free(tmp);
+        return e;
+    }
+    int d = net->dim, ok = 1;
+    ok &= fprintf(f, "# libodhs contacts N=%zu dim=%d Nc=%zu\n", net->n, d, net->nc) > 0;
+    ok &= fprintf(f, "# i j %s force gap\n", d == 2 ? "s0 s1" : "s0 s1 s2") > 0;
+    for (size_t c = 0; c < net->nc && ok; ++c) {
+        size_t i = net->ci[c], j = net->cj[c];
+        double v[3] = {0, 0, 0};
+        int img[3] = {0, 0, 0};
+        for (int a = 0; a < d; ++a) v[a] = sys->x[j * d + a] - sys->x[i * d + a];
+        odhs__min_image(d, sys->L, sys->gamma, v, img);
+        if (d == 2)
+            ok &= fprintf(f, "%zu %zu %d %d %.17g %.17g\n", i, j, img[0], img[1], net->f[c], net->gap[c]) > 0;
+        else
+            ok &= fprintf(f, "%zu %zu %d %d %d %.17g %.17g\n", i, j, img[0], img[1], img[2], net->f[c],
+                          net->gap[c]) > 0;
+    }
+    ok &= fflush(f) == 0;
+    ok &= fclose(f) == 0;
+    if (!ok || rename(tmp, path) != 0) {
+        remove(tmp);
+        int e = odhs__neterr(net, ODHS_E_IO, "error writing %s", path);
+        odhs__free(tmp);
+        return e;
+    }
+    odhs__free(tmp);
+    return ODHS_OK;
 }

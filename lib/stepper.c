@@ -244,10 +244,7 @@ static int rewire(odhs_stepper *st)
          * self-stress f0 plays the part of the forces */
         int pj = 0;
         if ((s = odhs_network_potentially_jammed(net, &pj))) return sterr(st, s, "%s", net->errmsg);
-        if (pj && st->drv->pressure_on)
-            return sterr(st, ODHS_POTENTIALLY_JAMMED,
-                         "potentially jammed under fixed pressure at t = %.17g (not handled yet)", st->time);
-        if (pj) {
+            if (pj) {
             if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
                 return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED,
                              "potentially jammed at t = %.17g: %s", st->time, net->errmsg);
@@ -275,8 +272,13 @@ static int rewire(odhs_stepper *st)
             continue;
         }
         if (pj) {
-            /* positive self-stress: jammed. Forces = f0 scaled to unit
+            /* positive self-stress: jammed. Polish the contacts to round-off,
+             * recompute f0 on the final geometry and scale it to unit
              * pressure; nothing can move under this driving. */
+            if ((s = odhs__jam_polish(st->sys, net, st->sol, net->f)))
+                return sterr(st, s, "polishing the jammed packing: %s", odhs_strerror(s));
+            if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
+                return sterr(st, ODHS_POTENTIALLY_JAMMED, "jammed packing: %s", net->errmsg);
             double fr = 0.0, vol;
             for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
             odhs_system_volume(st->sys, &vol);

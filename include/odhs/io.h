@@ -46,6 +46,22 @@ ODHS_API int odhs_xyz_parse(const char *buf, size_t len, odhs_system **out, char
  */
 ODHS_API int odhs_xyz_write(const odhs_system *sys, const char *path);
 
+struct odhs_network; /* see network.h */
+
+/**
+ * Draw the configuration as an SVG picture in the style of the paper's figures:
+ * discs coloured by size (below/above the median radius; 3D systems are
+ * projected on the x-y plane), the periodic (sheared) cell, and, when net is
+ * not NULL, every contact as a line from centre to centre whose width is
+ * proportional to its force (negative forces of permanent contacts dashed).
+ * mark (N flags, may be NULL) highlights particles: 1 = grey with a red ring
+ * (rattlers), 2 = dark red (e.g. a clogging arch). The file is written to a
+ * temporary name and renamed. Errors: ODHS_E_NULL, ODHS_E_STATE, ODHS_E_DIM,
+ * ODHS_E_IO.
+ */
+ODHS_API int odhs_svg_write(const odhs_system *sys, const struct odhs_network *net,
+                            const unsigned char *mark, const char *path);
+
 #ifdef __cplusplus
 }
 #endif

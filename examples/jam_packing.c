@@ -1,0 +1,237 @@
+/* jam_packing - certified jammed packings of hard discs/spheres with libodhs
+ * (Sect. IV D of Lerner, During & Wyart 2013).
+ *
+ * Builds (or reads) a scene, drives it until the event-driven rewiring finds
+ * an isostatic backbone with positive self-stress, and prints the certificate.
+ *
+ *     cc jam_packing.c $(pkg-config --cflags --libs odhs) -lm -o jam_packing
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <odhs.h>
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: jam_packing [options]\n"
+            "  --protocol P       compress | shear | shear+compress | pressure (default compress)\n"
+            "  --in FILE.xyz      start from a configuration file (default: built-in scene)\n"
+            "  --out FILE.xyz     write the jammed packing\n"
+            "  --contacts FILE    write its contacts (i j image force gap)\n"
+            "  --svg FILE.svg     draw it: discs by size, force chains, rattlers marked\n"
+            "  --n N              built-in scene: number of particles (default 256)\n"
+            "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
+            "  --seed S           built-in scene: random seed (default 1)\n"
+            "  --solver NAME      linear solver (default dense up to N = 2000, else cg)\n"
+            "  --dt X             step in natural units (default 1e-3)\n"
+            "  --max-strain X     shear protocols: give up after this strain (default 20)\n"
+            "  --help             this message\n"
+            "Protocols: compress = isotropic compression; shear = compress to jamming,\n"
+            "dilate by 0.2%% and shear at fixed volume until arrest; shear+compress =\n"
+            "shear with compression at 1/5 of the shear rate; pressure = shear at fixed\n"
+            "pressure, doubled every 0.05 strain (towards zero strain rate).\n"
+            "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed.\n");
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_ulong(const char *s, unsigned long *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long v = strtoul(s, &end, 10);
+    if (errno || end == s || *end || s[0] == '-') return -1;
+    *out = v;
+    return 0;
+}
+
+/* drive with the given driver until jammed (or failure / strain budget) */
+static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, double max_strain)
+{
+    int rc;
+    if (!shear) return odhs_stepper_run_until_packing_fraction(st, 0.999);
+    double g0;
+    odhs_stepper_strain(st, &g0);
+    double p = 1.0;
+    for (double g = g0; g < g0 + max_strain;) {
+        g += 0.05;
+        rc = odhs_stepper_run_until_strain(st, g);
+        if (rc) return rc;
+        if (pressure) {
+            p *= 2.0;
+            odhs_driver_set_pressure(drv, p);
+        }
+    }
+    return ODHS_OK;
+}
+
+int main(int argc, char **argv)
+{
+    const char *protocol = "compress", *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL,
+               *solver_name = NULL;
+    double dt = 1e-3, max_strain = 20.0;
+    unsigned long n = 256, seed = 1, dim = 2;
+    for (int a = 1; a < argc; ++a) {
+        const char *o = argv[a];
+        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
+            usage(stdout);
+            return 0;
+        }
+        if (a + 1 >= argc) {
+            fprintf(stderr, "jam_packing: unknown option or missing value: %s\n", o);
+            usage(stderr);
+            return 2;
+        }
+        const char *v = argv[++a];
+        int bad = 0;
+        if (!strcmp(o, "--protocol")) {
+            protocol = v;
+            bad = strcmp(v, "compress") && strcmp(v, "shear") && strcmp(v, "shear+compress") &&
+                  strcmp(v, "pressure");
+        } else if (!strcmp(o, "--in")) in = v;
+        else if (!strcmp(o, "--out")) outpath = v;
+        else if (!strcmp(o, "--contacts")) contacts = v;
+        else if (!strcmp(o, "--svg")) svg = v;
+        else if (!strcmp(o, "--solver")) solver_name = v;
+        else if (!strcmp(o, "--dt")) bad = parse_double(v, &dt) || dt <= 0;
+        else if (!strcmp(o, "--max-strain")) bad = parse_double(v, &max_strain) || max_strain <= 0;
+        else if (!strcmp(o, "--n")) bad = parse_ulong(v, &n) || n < 2;
+        else if (!strcmp(o, "--seed")) bad = parse_ulong(v, &seed);
+        else if (!strcmp(o, "--dim")) bad = parse_ulong(v, &dim) || (dim != 2 && dim != 3);
+        else {
+            fprintf(stderr, "jam_packing: unknown option %s\n", o);
+            usage(stderr);
+            return 2;
+        }
+        if (bad) {
+            fprintf(stderr, "jam_packing: bad value for %s: %s\n", o, v);
+            usage(stderr);
+            return 2;
+        }
+    }
+
+    odhs_system *sys = NULL;
+    int rc;
+    if (in) {
+        char err[512];
+        if ((rc = odhs_xyz_read(in, &sys, err, sizeof err))) {
+            fprintf(stderr, "jam_packing: cannot read %s: %s\n", in, err);
+            return 1;
+        }
+    } else if ((rc = odhs_system_create((int)dim, n, &sys)) ||
+               (rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed)) ||
+               (rc = odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.30, seed + 1))) {
+        fprintf(stderr, "jam_packing: building the scene: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
+        return 1;
+    }
+    n = odhs_system_count(sys);
+    if (!solver_name) solver_name = n <= 2000 ? "dense" : "cg";
+    odhs_solver *solver;
+    if ((rc = odhs_solver_create_by_name(solver_name, &solver))) {
+        fprintf(stderr, "jam_packing: solver %s: %s\n", solver_name, odhs_strerror(rc));
+        return 2;
+    }
+    odhs_driver *drv;
+    odhs_stepper *st;
+    if (odhs_driver_create(&drv) || odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt)) {
+        fprintf(stderr, "jam_packing: setup failed\n");
+        return 1;
+    }
+    fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s\n", n, odhs_system_dim(sys), protocol,
+            solver_name);
+
+    if (!strcmp(protocol, "compress")) {
+        odhs_driver_set_compression_rate(drv, 1.0);
+        rc = drive(st, drv, 0, 0, 0);
+    } else if (!strcmp(protocol, "shear")) {
+        odhs_driver_set_compression_rate(drv, 1.0);
+        rc = drive(st, drv, 0, 0, 0);
+        if (rc == ODHS_JAMMED) {
+            /* dilate slightly (all contacts open) and shear at fixed volume */
+            double phi;
+            odhs_system_packing_fraction(sys, &phi);
+            odhs_stepper_destroy(st);
+            odhs_system_scale_box(sys, pow(1.002, 1.0 / odhs_system_dim(sys)));
+            odhs_driver_set_compression_rate(drv, 0.0);
+            odhs_driver_set_shear_rate(drv, 1.0);
+            if (odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt)) return 1;
+            fprintf(stderr, "jam_packing: compression jammed at phi = %.6f; shearing at phi = %.6f\n", phi,
+                    phi / 1.002);
+            rc = drive(st, drv, 1, 0, max_strain);
+        }
+    } else if (!strcmp(protocol, "shear+compress")) {
+        odhs_driver_set_shear_rate(drv, 1.0);
+        odhs_driver_set_compression_rate(drv, 0.2);
+        rc = drive(st, drv, 0, 0, 0);
+    } else { /* pressure */
+        odhs_driver_set_shear_rate(drv, 1.0);
+        odhs_driver_set_pressure(drv, 1.0);
+        rc = drive(st, drv, 1, 1, max_strain);
+    }
+    int status = 0;
+    if (rc == ODHS_JAMMED) {
+        fprintf(stderr, "jam_packing: jammed\n");
+    } else if (rc == ODHS_OK) {
+        fprintf(stderr, "jam_packing: did not jam within the strain budget\n");
+        status = 3;
+    } else {
+        fprintf(stderr, "jam_packing: stopped: %s (%s)\n", odhs_strerror(rc), odhs_stepper_errmsg(st));
+        status = rc > 0 ? 3 : 1;
+    }
+
+    odhs_jam_certificate c;
+    c.size = sizeof c;
+    if (odhs_stepper_certificate(st, &c) == ODHS_OK) {
+        double strain, t;
+        odhs_stepper_strain(st, &strain);
+        odhs_stepper_time(st, &t);
+        printf("jammed                 %s\n", c.jammed ? "yes" : "no");
+        printf("phi_J                  %.15f\n", c.phi);
+        printf("strain                 %.6f\n", strain);
+        printf("particles              %zu (backbone %zu, rattlers %zu = %.2f%%)\n", c.n_particles, c.n_backbone,
+               c.n_rattlers, 100.0 * (double)c.n_rattlers / (double)c.n_particles);
+        printf("contacts               %zu (backbone %zu, isostatic count d(Nbar-1)+1 = %zu)\n", c.n_contacts,
+               c.n_contacts_backbone, c.n_contacts_isostatic);
+        printf("z, z_backbone          %.6f, %.6f\n", c.z, c.z_backbone);
+        printf("pressure               %.6g\n", c.pressure);
+        printf("force balance residual %.3e (relative to the mean force)\n", c.force_balance);
+        printf("worst contact gap      %.3e (relative to the contact distance)\n", c.gap_error);
+        printf("worst overlap          %.3e\n", c.overlap);
+        printf("smallest force         %.3e (relative to the mean force)\n", c.min_force);
+    }
+    const odhs_network *net = odhs_stepper_network(st);
+    if (outpath && odhs_xyz_write(sys, outpath)) {
+        fprintf(stderr, "jam_packing: cannot write %s: %s\n", outpath, odhs_system_errmsg(sys));
+        status = 1;
+    }
+    if (contacts && odhs_contacts_write(net, sys, contacts)) {
+        fprintf(stderr, "jam_packing: cannot write %s: %s\n", contacts, odhs_network_errmsg(net));
+        status = 1;
+    }
+    if (svg) {
+        unsigned char *mark = malloc(n);
+        if (mark) odhs_network_rattlers(net, mark, NULL);
+        if (odhs_svg_write(sys, net, mark, svg)) {
+            fprintf(stderr, "jam_packing: cannot write %s: %s\n", svg, odhs_system_errmsg(sys));
+            status = 1;
+        }
+        free(mark);
+    }
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(solver);
+    odhs_system_destroy(sys);
+    return status;
+}

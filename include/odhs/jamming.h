@@ -1,0 +1,66 @@
+/*
+ * libodhs - jamming.h: certified jammed packings (Sect. IV D of the paper).
+ *
+ * A stepper whose rewiring meets a potentially jammed network (the
+ * constrained subset has exactly d(Nbar-1)+1 contacts, eq. 29) computes the
+ * self-stress f0 (S^T f0 = 0, see odhs_network_null_vector). If every
+ * component is positive the packing is jammed: the stepper polishes the
+ * contacts (the gap component along f0 is removed by a tiny isotropic
+ * rescaling, the rest by non-affine displacements), stores f0 scaled to unit
+ * pressure as the contact forces, and returns ODHS_JAMMED. Otherwise the most
+ * negative contact is removed and the rewiring goes on, exactly as Sect. IV D
+ * describes.
+ */
+#ifndef ODHS_JAMMING_H
+#define ODHS_JAMMING_H
+
+#include "odhs/stepper.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * Certificate of a packing. Set `size` to sizeof(odhs_jam_certificate)
+ * before the call: fields beyond it (added in later versions) are not written.
+ * Forces are relative to the mean force on the backbone (the constrained
+ * subset); gaps and overlaps relative to the pair's contact distance.
+ */
+typedef struct odhs_jam_certificate {
+    size_t size;                 /* in: sizeof(odhs_jam_certificate)            */
+    int jammed;                  /* 1: the stepper found the packing jammed     */
+    int isostatic;               /* backbone contacts == d(Nbar-1)+1            */
+    double phi;                  /* packing fraction                             */
+    double pressure;             /* <f|r>/(Omega d) of the stored forces          */
+    size_t n_particles;
+    size_t n_rattlers;           /* particles outside the backbone               */
+    size_t n_backbone;           /* Nbar                                         */
+    size_t n_contacts;           /* all contacts                                 */
+    size_t n_contacts_backbone;  /* contacts inside the backbone                 */
+    size_t n_contacts_isostatic; /* d(Nbar-1)+1                                  */
+    double z;                    /* 2 Nc / N                                     */
+    double z_backbone;           /* 2 Nc_backbone / Nbar                         */
+    double force_balance;        /* max over backbone particles |sum_c f_c n_c| / mean f */
+    double gap_error;            /* max over contacts |gap| / (a_i + a_j)        */
+    double overlap;              /* max over non-contact pairs of overlap/(a_i+a_j), 0 if none */
+    double min_force;            /* smallest backbone force / mean f             */
+} odhs_jam_certificate;
+
+/** Fill a certificate for the stepper's current state (jammed or not). */
+ODHS_API int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert);
+
+/**
+ * Write the contacts of a network to a text file: comment lines starting with
+ * '#' (N, dim, Nc and the column names), then one line per contact
+ * "i j s0 s1 [s2] force gap" with the lattice image shift s such that the
+ * contact vector is R_ij = x_j - x_i + s0 a + s1 b + s2 c (system.h), the
+ * force and the gap, numbers with 17 significant digits. Written atomically
+ * (temporary file, then rename). Errors: ODHS_E_NULL, ODHS_E_DIM (system and
+ * network differ), ODHS_E_IO.
+ */
+ODHS_API int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const char *path);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* ODHS_JAMMING_H */

@@ -1,0 +1,144 @@
+/* libodhs - SVG pictures of configurations and force networks. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* lab -> picture coordinates (y up) */
+typedef struct {
+    double s, ox, oy, h;
+} view;
+
+static double px(const view *v, double x) { return v->ox + v->s * x; }
+static double py(const view *v, double y) { return v->h - (v->oy + v->s * y); }
+
+int odhs_svg_write(const odhs_system *sys, const odhs_network *net, const unsigned char *mark, const char *path)
+{
+    if (!sys) return ODHS_E_NULL;
+    if (!path) return odhs__syserr(sys, ODHS_E_NULL, "path is NULL");
+    if (!sys->has_x || !sys->has_r) return odhs__syserr(sys, ODHS_E_STATE, "radii and positions must be set");
+    if (net && (net->n != sys->n || net->dim != sys->dim))
+        return odhs__syserr(sys, ODHS_E_DIM, "network does not match the system");
+    int d = sys->dim;
+    size_t n = sys->n;
+    double Lx = sys->L[0], Ly = sys->L[1], g = sys->gamma;
+    /* picture: 800 px across the sheared cell plus a margin */
+    double xmin = fmin(0.0, g * Ly), xmax = fmax(Lx, Lx + g * Ly);
+    double W = 800.0, margin = 10.0;
+    view v;
+    v.s = (W - 2 * margin) / (xmax - xmin);
+    v.ox = margin - v.s * xmin;
+    v.oy = margin;
+    v.h = v.s * Ly + 2 * margin;
+    double *rs = odhs__malloc_array(n, sizeof *rs);
+    if (!rs) return odhs__syserr(sys, ODHS_E_NOMEM, "out of memory");
+    memcpy(rs, sys->r, n * sizeof *rs);
+    qsort(rs, n, sizeof *rs, cmp_double);
+    double rmed = rs[n / 2];
+    int bidisperse = rs[0] < rmed || rs[n - 1] > rmed;
+    odhs__free(rs);
+
+    size_t len = strlen(path);
+    char *tmp = odhs__malloc(len + 8);
+    if (!tmp) return odhs__syserr(sys, ODHS_E_NOMEM, "out of memory");
+    snprintf(tmp, len + 8, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        odhs__free(tmp);
+        return odhs__syserr(sys, ODHS_E_IO, "cannot write %s.tmp", path);
+    }
+    int ok = 1;
+    ok &= fprintf(f,
+                  "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+                  "viewBox=\"0 0 %.3f %.3f\">\n<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+                  W, v.h, W, v.h) > 0;
+    /* the periodic cell as a clip path and outline */
+    double cx[4] = {0, Lx, Lx + g * Ly, g * Ly}, cy[4] = {0, 0, Ly, Ly};
+    ok &= fprintf(f, "<defs><clipPath id=\"cell\"><polygon points=\"") > 0;
+    for (int k = 0; k < 4; ++k) ok &= fprintf(f, "%.3f,%.3f ", px(&v, cx[k]), py(&v, cy[k])) > 0;
+    ok &= fprintf(f, "\"/></clipPath></defs>\n<g clip-path=\"url(#cell)\">\n") > 0;
+    /* discs, with the periodic images that reach into the cell */
+    for (size_t i = 0; i < n && ok; ++i) {
+        const double *x = sys->x + i * d;
+        double r = sys->r[i];
+        const char *fill = !bidisperse ? "#9ecae1" : (r < rmed ? "#9ecae1" : "#fdae6b");
+        const char *stroke = "#444444";
+        double sw = 0.6;
+        if (mark && mark[i] == 1) {
+            fill = "#d9d9d9";
+            stroke = "#cb181d";
+            sw = 2.0;
+        } else if (mark && mark[i] == 2) {
+            fill = "#a50f15";
+        }
+        for (int iy = -1; iy <= 1; ++iy)
+            for (int ix = -2; ix <= 2; ++ix) {
+                double X = x[0] + ix * Lx + iy * g * Ly, Y = x[1] + iy * Ly;
+                /* skip images that cannot touch the cell */
+                if (Y + r < 0 || Y - r > Ly) continue;
+                double xl = g * Y; /* left edge of the sheared cell at height Y: x' = x - gamma*y */
+                if (X - g * Y + r < 0 || X - g * Y - r > Lx) continue;
+                (void)xl;
+                ok &= fprintf(f,
+                              "<circle cx=\"%.3f\" cy=\"%.3f\" r=\"%.3f\" fill=\"%s\" stroke=\"%s\" "
+                              "stroke-width=\"%.2f\"/>\n",
+                              px(&v, X), py(&v, Y), v.s * r, fill, stroke, sw) > 0;
+            }
+    }
+    /* force chains */
+    if (net && net->nc) {
+        double fmax = 0.0;
+        for (size_t c = 0; c < net->nc; ++c) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
+        double wmax = 0.3 * v.s * sys->rmax;
+        for (size_t c = 0; c < net->nc && ok; ++c) {
+            size_t i = net->ci[c], j = net->cj[c];
+            double dv[3] = {0, 0, 0};
+            for (int a = 0; a < d; ++a) dv[a] = sys->x[j * d + a] - sys->x[i * d + a];
+            odhs__min_image(d, sys->L, g, dv, NULL);
+            double w = fmax > 0.0 ? wmax * fabs(net->f[c]) / fmax : 1.0;
+            if (w < 0.4) w = 0.4;
+            const char *dash = net->f[c] < 0.0 ? " stroke-dasharray=\"3,2\"" : "";
+            const char *col = net->kind[c] == ODHS_CONTACT_PERMANENT ? "#08306b" : "#000000";
+            /* draw from both ends so contacts across the boundary show twice */
+            for (int side = 0; side < 2; ++side) {
+                const double *a = sys->x + (side ? j : i) * d;
+                double sgn = side ? -1.0 : 1.0;
+                for (int iy = -1; iy <= 1; ++iy)
+                    for (int ix = -1; ix <= 1; ++ix) {
+                        double X = a[0] + ix * Lx + iy * g * Ly, Y = a[1] + iy * Ly;
+                        if (Y < -Ly * 0.5 || Y > Ly * 1.5) continue;
+                        if (ix || iy) {
+                            double xs = X - g * Y;
+                            double ext = 2.5 * sys->rmax;
+                            if (Y < -ext || Y > Ly + ext || xs < -ext || xs > Lx + ext) continue;
+                        }
+                        ok &= fprintf(f,
+                                      "<line x1=\"%.3f\" y1=\"%.3f\" x2=\"%.3f\" y2=\"%.3f\" stroke=\"%s\" "
+                                      "stroke-width=\"%.2f\" stroke-linecap=\"round\"%s/>\n",
+                                      px(&v, X), py(&v, Y), px(&v, X + 0.5 * sgn * dv[0]),
+                                      py(&v, Y + 0.5 * sgn * dv[1]), col, w, dash) > 0;
+                    }
+            }
+        }
+    }
+    ok &= fprintf(f, "</g>\n<polygon points=\"") > 0;
+    for (int k = 0; k < 4; ++k) ok &= fprintf(f, "%.3f,%.3f ", px(&v, cx[k]), py(&v, cy[k])) > 0;
+    ok &= fprintf(f, "\" fill=\"none\" stroke=\"#252525\" stroke-width=\"1.5\"/>\n</svg>\n") > 0;
+    ok &= fflush(f) == 0;
+    ok &= fclose(f) == 0;
+    int st = ODHS_OK;
+    if (!ok || rename(tmp, path) != 0) {
+        remove(tmp);
+        st = odhs__syserr(sys, ODHS_E_IO, "error writing %s", path);
+    }
+    odhs__free(tmp);
+    return st;
+}
