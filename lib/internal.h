@@ -125,6 +125,7 @@ struct odhs_solver {
     uint64_t last_sum; /* checksum of the operator last set up (public path) */
     int have_setup;
     double check_tol;
+    int refine;        /* iterative refinement steps for direct backends */
     double last_residual;
     double nsolves;
     double *work;    /* residual check */

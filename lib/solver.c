@@ -27,6 +27,7 @@ int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out)
     if (!s) return ODHS_E_NOMEM;
     s->type = type;
     s->check_tol = 1e-6;
+    s->refine = 3;
     int st = type->create(&s->state);
     if (st) {
         odhs__free(s);
@@ -84,6 +85,14 @@ int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value)
     }
     if (s->type->get_stat && s->type->get_stat(s->state, key, value) == ODHS_OK) return ODHS_OK;
     return solerr(s, ODHS_E_INVALID, "unknown statistic %s", key);
+}
+
+int odhs_solver_set_refinement(odhs_solver *s, int steps)
+{
+    if (!s) return ODHS_E_NULL;
+    if (steps < 0 || steps > 100) return solerr(s, ODHS_E_INVALID, "refinement steps must be in [0, 100]");
+    s->refine = steps;
+    return ODHS_OK;
 }
 
 int odhs_solver_set_check_tolerance(odhs_solver *s, double tol)
@@ -182,6 +191,29 @@ static int solve_any(odhs_solver *s, const odhs_network *net, const double *b, c
         bn += b[c] * b[c];
     }
     s->last_residual = bn > 0.0 ? sqrt(rn / bn) : sqrt(rn);
+    /* iterative refinement for direct backends on ill-conditioned networks
+     * (close to jamming): x += N^-1 (b - N x), a few times at most */
+    if (st == ODHS_OK && s->refine > 0 && !(s->type->flags & ODHS_SOLVER_ITERATIVE)) {
+        double *r = odhs__malloc_array(2 * nc, sizeof *r);
+        for (int pass = 0; r && pass < s->refine && s->last_residual > 1e-14; ++pass) {
+            double *dx = r + nc;
+            for (size_t c = 0; c < nc; ++c) r[c] = b[c] - Nx[c];
+            memset(dx, 0, nc * sizeof *dx);
+            if (s->type->solve(s->state, net, r, dx) != ODHS_OK) break;
+            for (size_t c = 0; c < nc; ++c) dx[c] += x[c];
+            odhs__net_N(net, dx, Nx, tmp);
+            double rn2 = 0.0;
+            for (size_t c = 0; c < nc; ++c) rn2 += (Nx[c] - b[c]) * (Nx[c] - b[c]);
+            double res2 = bn > 0.0 ? sqrt(rn2 / bn) : sqrt(rn2);
+            if (!(res2 < s->last_residual)) {
+                odhs__net_N(net, x, Nx, tmp); /* keep the better x */
+                break;
+            }
+            memcpy(x, dx, nc * sizeof *x);
+            s->last_residual = res2;
+        }
+        odhs__free(r);
+    }
     if (st < 0)
         return solerr(s, st, "%s: solve failed (%s), relative residual %.3g", s->type->name, odhs_strerror(st),
                       s->last_residual);

@@ -574,9 +574,18 @@ START_TEST(test_wrapper_checks)
     ck_assert_int_eq(odhs_solver_create(&ge_type_iterative, &gi), ODHS_OK);
     ck_assert_int_eq(odhs_solver_set_param(ge, "eps", 1e-4), ODHS_OK);
     ck_assert_int_eq(odhs_solver_set_param(gi, "eps", 1e-4), ODHS_OK);
-    /* default check tolerance 1e-6: a direct backend is reported singular,
-     * an iterative one as not converged */
+    /* with the default iterative refinement, the (1+eps)-scaled direct
+     * solution is refined to round-off ((1+eps)(1-eps) -> 1 - eps^2 -> ...) */
     int st = odhs_solver_solve(ge, c.net, b, x);
+    ck_assert_msg(st == ODHS_OK, "refined direct backend: %d", st);
+    ck_assert_msg(sv_stat(ge, "residual") < 1e-12, "refined residual %g", sv_stat(ge, "residual"));
+    for (size_t k = 0; k < c.nc; ++k) ck_assert(fabs(x[k] - xd[k]) <= 1e-10 * (1.0 + fabs(xd[k])));
+    ck_assert_int_eq(odhs_solver_set_refinement(ge, -1), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_refinement(NULL, 1), ODHS_E_NULL);
+    /* without refinement, default check tolerance 1e-6: a direct backend is
+     * reported singular, an iterative one as not converged */
+    ck_assert_int_eq(odhs_solver_set_refinement(ge, 0), ODHS_OK);
+    st = odhs_solver_solve(ge, c.net, b, x);
     ck_assert_msg(st == ODHS_E_SINGULAR, "direct backend with residual 1e-4: %d", st);
     ck_assert_str_ne(odhs_solver_errmsg(ge), "");
     ck_assert_msg(fabs(sv_stat(ge, "residual") / 1e-4 - 1.0) < 1e-6, "residual stat %.17g, expected 1e-4",
