@@ -98,6 +98,15 @@ struct odhs_network {
     uint64_t *hkey;  /* 0 = empty, else i*n + j + 1 */
     size_t *hval;
     uint64_t version; /* bumped on every change of contacts or geometry */
+    /* constrained subset (the (d+1)-core of the contact graph), maintained
+     * incrementally on every add/remove, in integers */
+    size_t **adj;          /* per particle: partners */
+    uint32_t *adjn, *adjcap;
+    unsigned char *core;   /* 1 = in the constrained subset */
+    size_t *cdeg;          /* number of neighbours in the core */
+    size_t nbar, ncon;     /* core size, contacts inside the core */
+    size_t *work;          /* scratch: queue (n) */
+    unsigned char *mark;   /* scratch flags (n) */
     char errmsg[ODHS_ERRMSG_LEN];
 };
 

@@ -82,7 +82,15 @@ odhs_network *odhs__net_new(int dim, size_t n)
     if (!net) return NULL;
     net->dim = dim;
     net->n = n;
-    if (grow(net)) {
+    net->adj = odhs__calloc(n, sizeof *net->adj);
+    net->adjn = odhs__calloc(n, sizeof *net->adjn);
+    net->adjcap = odhs__calloc(n, sizeof *net->adjcap);
+    net->core = odhs__calloc(n, 1);
+    net->cdeg = odhs__calloc(n, sizeof *net->cdeg);
+    net->work = odhs__calloc(2 * n + 2, sizeof *net->work);
+    net->mark = odhs__calloc(n, 1);
+    if (!net->adj || !net->adjn || !net->adjcap || !net->core || !net->cdeg || !net->work || !net->mark ||
+        grow(net)) {
         odhs_network_destroy(net);
         return NULL;
     }
@@ -110,6 +118,15 @@ void odhs_network_destroy(odhs_network *net)
     odhs__free(net->f);
     odhs__free(net->hkey);
     odhs__free(net->hval);
+    if (net->adj)
+        for (size_t i = 0; i < net->n; ++i) odhs__free(net->adj[i]);
+    odhs__free(net->adj);
+    odhs__free(net->adjn);
+    odhs__free(net->adjcap);
+    odhs__free(net->core);
+    odhs__free(net->cdeg);
+    odhs__free(net->work);
+    odhs__free(net->mark);
     odhs__free(net);
 }
 
@@ -134,6 +151,149 @@ size_t odhs__net_find(const odhs_network *net, size_t i, size_t j)
     return SIZE_MAX;
 }
 
+/* ---- the constrained subset, incrementally -------------------------------
+ * The constrained subset of Sect. IV D is the (d+1)-core of the contact graph:
+ * the largest set of particles each with at least d+1 contacts inside it. It
+ * only grows when a contact is added and only shrinks when one is removed.
+ * Invariant: cdeg[x] = number of partners of x in the core, for every x. */
+static int adj_reserve(odhs_network *net, size_t i)
+{
+    if (net->adjn[i] < net->adjcap[i]) return ODHS_OK;
+    uint32_t cap = net->adjcap[i] ? 2 * net->adjcap[i] : 8;
+    size_t *a = odhs__realloc(net->adj[i], cap * sizeof *a);
+    if (!a) return ODHS_E_NOMEM;
+    net->adj[i] = a;
+    net->adjcap[i] = cap;
+    return ODHS_OK;
+}
+
+static void adj_remove(odhs_network *net, size_t i, size_t j)
+{
+    for (uint32_t k = 0; k < net->adjn[i]; ++k)
+        if (net->adj[i][k] == j) {
+            net->adj[i][k] = net->adj[i][--net->adjn[i]];
+            return;
+        }
+}
+
+/* x joins the core: count its contacts to core members, tell its partners */
+static void core_join(odhs_network *net, size_t x)
+{
+    net->core[x] = 1;
+    net->nbar++;
+    for (uint32_t k = 0; k < net->adjn[x]; ++k) {
+        size_t y = net->adj[x][k];
+        net->cdeg[y]++;
+        if (net->core[y]) net->ncon++;
+    }
+}
+
+/* peel core members whose core degree fell below d+1, starting from queue */
+static void core_peel(odhs_network *net, size_t qt)
+{
+    size_t need = (size_t)net->dim + 1, qh = 0, *q = net->work;
+    while (qh < qt) {
+        size_t x = q[qh++];
+        if (!net->core[x] || net->cdeg[x] >= need) continue;
+        net->core[x] = 0;
+        net->nbar--;
+        for (uint32_t k = 0; k < net->adjn[x]; ++k) {
+            size_t y = net->adj[x][k];
+            net->cdeg[y]--;
+            if (net->core[y]) {
+                net->ncon--;
+                /* pushed once, when its core degree first drops below d+1:
+                 * with the two seeds the queue holds at most n + 2 */
+                if (net->cdeg[y] == need - 1) q[qt++] = y;
+            }
+        }
+    }
+}
+
+static void core_edge_added(odhs_network *net, size_t i, size_t j)
+{
+    size_t need = (size_t)net->dim + 1;
+    if (net->core[i] && net->core[j]) {
+        net->cdeg[i]++;
+        net->cdeg[j]++;
+        net->ncon++;
+        return;
+    }
+    if (net->core[i]) net->cdeg[j]++;
+    if (net->core[j]) net->cdeg[i]++;
+    /* candidates: non-core particles with >= d+1 contacts reachable from the
+     * new contact through non-core particles */
+    size_t *q = net->work, qt = 0;
+    unsigned char *inC = net->mark;
+    size_t ends[2] = {i, j};
+    for (int e = 0; e < 2; ++e) {
+        size_t x = ends[e];
+        if (!net->core[x] && !inC[x] && net->adjn[x] >= need) {
+            inC[x] = 1;
+            q[qt++] = x;
+        }
+    }
+    for (size_t h = 0; h < qt; ++h) {
+        size_t x = q[h];
+        for (uint32_t k = 0; k < net->adjn[x]; ++k) {
+            size_t y = net->adj[x][k];
+            if (!net->core[y] && !inC[y] && net->adjn[y] >= need) {
+                inC[y] = 1;
+                q[qt++] = y;
+            }
+        }
+    }
+    if (qt == 0) return;
+    /* peel the candidates: cnt = core partners + candidate partners. cdeg of
+     * candidates is only read here, so use it to hold cnt temporarily. */
+    size_t nC = qt;
+    for (size_t h = 0; h < nC; ++h) {
+        size_t x = q[h], cnt = net->cdeg[x];
+        for (uint32_t k = 0; k < net->adjn[x]; ++k) cnt += inC[net->adj[x][k]];
+        net->cdeg[x] = cnt;
+    }
+    /* iterative removal with a queue (candidates whose count drops below d+1
+     * are queued once, when they cross); removed candidates get inC = 2 */
+    size_t *rq = q + nC, rh = 0, rt = 0;
+    for (size_t h = 0; h < nC; ++h)
+        if (net->cdeg[q[h]] < need) rq[rt++] = q[h];
+    while (rh < rt) {
+        size_t x = rq[rh++];
+        if (inC[x] != 1) continue;
+        inC[x] = 2;
+        for (uint32_t k = 0; k < net->adjn[x]; ++k) {
+            size_t y = net->adj[x][k];
+            if (inC[y] == 1 && net->cdeg[y]-- == need) rq[rt++] = y;
+        }
+    }
+    /* restore cdeg of candidates to "core partners" and admit the survivors */
+    for (size_t h = 0; h < nC; ++h) {
+        size_t x = q[h], c = 0;
+        for (uint32_t k = 0; k < net->adjn[x]; ++k) c += net->core[net->adj[x][k]];
+        net->cdeg[x] = c;
+    }
+    for (size_t h = 0; h < nC; ++h) {
+        size_t x = q[h];
+        if (inC[x] == 1) core_join(net, x);
+    }
+    for (size_t h = 0; h < nC; ++h) inC[q[h]] = 0;
+}
+
+static void core_edge_removed(odhs_network *net, size_t i, size_t j)
+{
+    if (net->core[i] && net->core[j]) {
+        net->ncon--;
+        net->cdeg[i]--;
+        net->cdeg[j]--;
+        net->work[0] = i;
+        net->work[1] = j;
+        core_peel(net, 2);
+        return;
+    }
+    if (net->core[i]) net->cdeg[j]--;
+    if (net->core[j]) net->cdeg[i]--;
+}
+
 size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
 {
     if (i > j) {
@@ -142,6 +302,7 @@ size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
         j = t;
     }
     if (net->nc == net->cap && grow(net)) return SIZE_MAX;
+    if (adj_reserve(net, i) || adj_reserve(net, j)) return SIZE_MAX;
     size_t c = net->nc++;
     net->ci[c] = i;
     net->cj[c] = j;
@@ -153,6 +314,9 @@ size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
     while (net->hkey[s]) s = (s + 1) & mask;
     net->hkey[s] = key;
     net->hval[s] = c;
+    net->adj[i][net->adjn[i]++] = j;
+    net->adj[j][net->adjn[j]++] = i;
+    core_edge_added(net, i, j);
     net->version++;
     return c;
 }
@@ -188,6 +352,9 @@ static void hash_set(odhs_network *net, uint64_t key, size_t val)
 void odhs__net_remove_at(odhs_network *net, size_t k)
 {
     hash_delete(net, pair_key(net, net->ci[k], net->cj[k]));
+    adj_remove(net, net->ci[k], net->cj[k]);
+    adj_remove(net, net->cj[k], net->ci[k]);
+    core_edge_removed(net, net->ci[k], net->cj[k]);
     size_t last = net->nc - 1;
     if (k != last) {
         int d = net->dim;
@@ -455,63 +622,10 @@ int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon
                              unsigned char *in_subset, long *zbar_num)
 {
     if (!net) return ODHS_E_NULL;
-    size_t n = net->n, nc = net->nc;
-    size_t *deg = odhs__calloc(n, sizeof *deg);
-    size_t *start = odhs__calloc(n + 1, sizeof *start);
-    size_t *adj = odhs__malloc_array(2 * nc, sizeof *adj);
-    size_t *queue = odhs__malloc_array(n, sizeof *queue);
-    unsigned char *alive = odhs__malloc_array(n, 1);
-    if (!deg || !start || !adj || !queue || !alive) {
-        odhs__free(deg);
-        odhs__free(start);
-        odhs__free(adj);
-        odhs__free(queue);
-        odhs__free(alive);
-        return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
-    }
-    for (size_t c = 0; c < nc; ++c) {
-        deg[net->ci[c]]++;
-        deg[net->cj[c]]++;
-    }
-    for (size_t i = 0; i < n; ++i) start[i + 1] = start[i] + deg[i];
-    {
-        size_t *fill = queue; /* reuse as fill pointers */
-        for (size_t i = 0; i < n; ++i) fill[i] = start[i];
-        for (size_t c = 0; c < nc; ++c) {
-            adj[fill[net->ci[c]]++] = net->cj[c];
-            adj[fill[net->cj[c]]++] = net->ci[c];
-        }
-    }
-    size_t need = (size_t)net->dim + 1, qh = 0, qt = 0;
-    for (size_t i = 0; i < n; ++i) {
-        alive[i] = 1;
-        if (deg[i] < need) {
-            alive[i] = 0;
-            queue[qt++] = i;
-        }
-    }
-    while (qh < qt) {
-        size_t i = queue[qh++];
-        for (size_t p = start[i]; p < start[i + 1]; ++p) {
-            size_t j = adj[p];
-            if (alive[j] && --deg[j] < need) {
-                alive[j] = 0;
-                queue[qt++] = j;
-            }
-        }
-    }
-    size_t nb = 0, cc = 0;
-    for (size_t i = 0; i < n; ++i) nb += alive[i];
-    for (size_t c = 0; c < nc; ++c) cc += alive[net->ci[c]] && alive[net->cj[c]];
-    if (nbar) *nbar = nb;
-    if (ncon) *ncon = cc;
-    if (zbar_num) *zbar_num = nb ? 2L * (net->dim - 1) + 2L * (long)cc : 0;
-    if (in_subset) memcpy(in_subset, alive, n);
-    odhs__free(deg);
-    odhs__free(start);
-    odhs__free(adj);
-    odhs__free(queue);
-    odhs__free(alive);
+    if (nbar) *nbar = net->nbar;
+    if (ncon) *ncon = net->ncon;
+    if (zbar_num) *zbar_num = net->nbar ? 2L * (net->dim - 1) + 2L * (long)net->ncon : 0;
+    if (in_subset) memcpy(in_subset, net->core, net->n);
     return ODHS_OK;
 }
 
@@ -531,9 +645,6 @@ int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
 {
     if (!net) return ODHS_E_NULL;
     if (!flag) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
-    size_t nb, cc;
-    int st = odhs_network_constrained(net, &nb, &cc, NULL, NULL);
-    if (st) return st;
-    *flag = nb > 0 && cc >= (size_t)net->dim * (nb - 1) + 1;
+    *flag = net->nbar > 0 && net->ncon >= (size_t)net->dim * (net->nbar - 1) + 1;
     return ODHS_OK;
 }
