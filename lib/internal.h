@@ -184,6 +184,12 @@ struct odhs_stepper {
     size_t n, nd;
     /* settings */
     double dt;
+    int integrator;   /* ODHS_INTEGRATOR_* */
+    double tol;       /* adaptive: error per step, relative to the mean diameter */
+    double h;         /* adaptive: current step in units of tau */
+    double lambda;    /* mean diameter */
+    double *U0, *Ua;  /* adaptive: velocities at the start, averaged (nd) */
+    uint64_t nrejected, nsolves_pred;
     unsigned corr_every;
     double contact_tol;
     odhs_event_fn evfn;

@@ -560,6 +560,9 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->n = sys->n;
     st->nd = sys->n * (size_t)sys->dim;
     st->dt = 1e-3;
+    st->integrator = ODHS_INTEGRATOR_EULER;
+    st->tol = 1e-6;
+    st->h = st->dt;
     st->corr_every = 10;
     st->contact_tol = 1e-9;
     st->F = odhs__calloc(st->nd, sizeof(double));
@@ -567,8 +570,10 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->tmp = odhs__calloc(st->nd, sizeof(double));
     st->disp = odhs__calloc(st->nd, sizeof(double));
     st->xs = odhs__calloc(st->nd, sizeof(double));
+    st->U0 = odhs__calloc(st->nd, sizeof(double));
+    st->Ua = odhs__calloc(st->nd, sizeof(double));
     int s = odhs_network_create(sys, &st->net);
-    if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || s) {
+    if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || !st->U0 || !st->Ua || s) {
         odhs_stepper_destroy(st);
         return ODHS_E_NOMEM;
     }
@@ -580,7 +585,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
 {
     if (!st) return;
     odhs_network_destroy(st->net);
-    void *arrays[] = {st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
+    void *arrays[] = {st->U0, st->Ua, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
                       st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->ev};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
@@ -594,6 +599,34 @@ int odhs_stepper_set_dt(odhs_stepper *st, double dt)
     if (!isfinite(dt)) return sterr(st, ODHS_E_NONFINITE, "dt is not finite");
     if (!(dt > 0.0)) return sterr(st, ODHS_E_INVALID, "dt = %g must be > 0", dt);
     st->dt = dt;
+    st->h = dt;
+    return ODHS_OK;
+}
+
+int odhs_stepper_set_integrator(odhs_stepper *st, int integrator)
+{
+    if (!st) return ODHS_E_NULL;
+    if (integrator != ODHS_INTEGRATOR_EULER && integrator != ODHS_INTEGRATOR_HEUN)
+        return sterr(st, ODHS_E_INVALID, "unknown integrator %d", integrator);
+    st->integrator = integrator;
+    st->h = st->dt;
+    return ODHS_OK;
+}
+
+int odhs_stepper_set_tolerance(odhs_stepper *st, double tol)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(tol) || !(tol > 0.0) || !(tol < 1.0))
+        return sterr(st, ODHS_E_INVALID, "tolerance %g must be in (0, 1)", tol);
+    st->tol = tol;
+    return ODHS_OK;
+}
+
+int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejected, double *h)
+{
+    if (!st) return ODHS_E_NULL;
+    if (rejected) *rejected = st->nrejected;
+    if (h) *h = st->h;
     return ODHS_OK;
 }
 
@@ -644,6 +677,9 @@ int odhs_stepper_reset(odhs_stepper *st)
     odhs__solver_invalidate(st->sol); /* our network may reuse a freed address */
     if ((s = check_driver(st))) return s;
     if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) return sterr(st, s, "%s", st->drv->errmsg);
+    st->lambda = 0.0;
+    for (size_t i = 0; i < st->n; ++i) st->lambda += 2.0 * st->sys->r[i];
+    st->lambda /= (double)st->n;
     /* keep permanent contacts, rebuild the temporary ones */
     odhs_network *net = st->net;
     odhs__net_geometry(net, st->sys);
@@ -743,6 +779,82 @@ static int collect_events(odhs_stepper *st)
 
 static int emit_events(odhs_stepper *st, odhs_event *first, int *stop);
 
+/* ---- adaptive Heun --------------------------------------------------------
+ * Predictor: move by tau*V0 (no collision checks: the configuration is only
+ * used to evaluate velocities on the same network), solve there for V*. The
+ * step uses the average velocity on a straight chord, so collisions are
+ * still located exactly on the motion actually taken. Error estimate: the
+ * difference between the Euler and Heun non-affine displacements,
+ * tau/2 max_i |U*_i - U0_i|, relative to the mean diameter. On return *Ga, st->Ua
+ * hold the chord's gradient and velocities and *tau the accepted step. */
+static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
+{
+    odhs_system *sys = st->sys;
+    odhs_network *net = st->net;
+    size_t nd = st->nd;
+    int s;
+    double G0[9], M0[9], k0 = st->kappa;
+    memcpy(G0, st->G, sizeof G0);
+    memcpy(M0, st->M, sizeof M0);
+    memcpy(st->U0, st->U, nd * sizeof *st->U0);
+    double *disp0 = st->Ua; /* borrow: disp is restored from it below */
+    for (int attempt = 0;; ++attempt) {
+        double tau = st->h * st->tau, truncated = 0;
+        if (limit < tau) {
+            tau = limit;
+            truncated = 1;
+        }
+        memcpy(disp0, st->disp, nd * sizeof *disp0);
+        double t0 = st->time;
+        advance(st, G0, st->U0, tau);
+        st->time = t0 + tau;
+        odhs__net_geometry(net, sys);
+        s = eval_forces(st);
+        if (!s) s = compute_forces(st);
+        st->time = t0;
+        if (!s) compute_velocities(st); /* st->U = U*, st->G = G* */
+        /* error estimate */
+        double emax = 0.0;
+        for (size_t i = 0; i < st->n && !s; ++i) {
+            double e2 = 0.0;
+            for (int k = 0; k < st->dim; ++k) {
+                double dv = st->U[i * st->dim + k] - st->U0[i * st->dim + k];
+                e2 += dv * dv;
+            }
+            emax = fmax(emax, e2);
+        }
+        double err = 0.5 * tau * sqrt(emax) / st->lambda;
+        double Gs[9];
+        memcpy(Gs, st->G, sizeof Gs);
+        /* restore the start of the step (forces in net->f stay as a guess) */
+        memcpy(sys->x, st->xs, nd * sizeof *sys->x);
+        memcpy(sys->L, st->Ls, sizeof st->Ls);
+        sys->gamma = st->gammas;
+        memcpy(st->M, M0, sizeof M0);
+        memcpy(st->disp, disp0, nd * sizeof *disp0);
+        odhs__net_geometry(net, sys);
+        memcpy(st->G, G0, sizeof G0);
+        st->kappa = k0;
+        if (s) {
+            memcpy(st->U, st->U0, nd * sizeof *st->U);
+            return s;
+        }
+        st->nsolves_pred++;
+        double fac = err > 0.0 ? 0.9 * sqrt(st->tol / err) : 2.0;
+        if (err <= st->tol || attempt >= 40) {
+            /* accepted: chord velocity = average */
+            for (size_t k = 0; k < nd; ++k) st->Ua[k] = 0.5 * (st->U0[k] + st->U[k]);
+            for (int a = 0; a < 9; ++a) Ga[a] = 0.5 * (G0[a] + Gs[a]);
+            memcpy(st->U, st->U0, nd * sizeof *st->U);
+            if (!truncated) st->h = fmin(st->dt, st->h * fmin(2.0, fac));
+            *tau_out = tau;
+            return ODHS_OK;
+        }
+        st->nrejected++;
+        st->h *= fmax(0.2, fac);
+    }
+}
+
 /* ---- one step ----------------------------------------------------------------- */
 /* limit: largest time to advance (INFINITY for none); *stop set by callbacks */
 static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
@@ -775,20 +887,26 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     }
     double tplan = st->dt * st->tau;
     if (limit < tplan) tplan = limit;
+    /* the chord of this step: gradient G and velocities vel */
+    double G[9];
+    const double *vel = st->U;
+    memcpy(G, st->G, sizeof G);
+    if (st->integrator == ODHS_INTEGRATOR_HEUN) {
+        if ((s = heun(st, limit, G, &tplan))) goto fail;
+        vel = st->Ua;
+    }
 
     /* neighbour-list validity over the step */
-    double rate = skin_rate(st, st->G, st->U);
+    double rate = skin_rate(st, G, vel);
     if (st->nb_stale || skin_used(st) + rate * tplan > st->skin) {
         st->nb_stale = 0;
         if ((s = build_neighbours(st))) goto fail;
-        rate = skin_rate(st, st->G, st->U);
+        rate = skin_rate(st, G, vel);
         if (rate * tplan > 0.9 * st->skin) tplan = 0.9 * st->skin / rate;
     }
     size_t ci, cj;
-    double t = predict(st, st->G, st->U, tplan, EPS_V * velocity_scale(st), &ci, &cj);
-    double G[9];
-    memcpy(G, st->G, sizeof G);
-    advance(st, G, st->U, t);
+    double t = predict(st, G, vel, tplan, EPS_V * velocity_scale(st), &ci, &cj);
+    advance(st, G, vel, t);
     st->time += t;
     st->strain += t * st->drv->gdot;
     st->nsteps++;

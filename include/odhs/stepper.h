@@ -70,8 +70,25 @@ ODHS_API void odhs_stepper_destroy(odhs_stepper *st);
 /** Last error message ("" if none). */
 ODHS_API const char *odhs_stepper_errmsg(const odhs_stepper *st);
 
-/** Step size in units of tau (default 1e-3). */
+/** Integrators (pinned values). */
+enum {
+    /** The paper's scheme: explicit Euler with the fixed step dt. */
+    ODHS_INTEGRATOR_EULER = 0,
+    /** Adaptive Heun (2nd-order Runge-Kutta with an embedded Euler error
+     *  estimate): the step is chosen so that the estimated non-affine position
+     *  error of a step stays below tol times the mean diameter, up to dt;
+     *  2 force solves per accepted step; contact gaps drift as O(h^3). */
+    ODHS_INTEGRATOR_HEUN = 1
+};
+
+/** Step size in units of tau (default 1e-3); the largest step with
+ *  ODHS_INTEGRATOR_HEUN. */
 ODHS_API int odhs_stepper_set_dt(odhs_stepper *st, double dt);
+/** Choose the integrator (default ODHS_INTEGRATOR_EULER). */
+ODHS_API int odhs_stepper_set_integrator(odhs_stepper *st, int integrator);
+/** Error tolerance of the adaptive integrator (relative to the mean diameter,
+ *  per step; default 1e-6; in (0, 1)). */
+ODHS_API int odhs_stepper_set_tolerance(odhs_stepper *st, double tol);
 /** Drift correction every k steps (default 10; 0 disables). */
 ODHS_API int odhs_stepper_set_correction_interval(odhs_stepper *st, unsigned k);
 /** Relative gap (gap / (a_i + a_j)) below which pairs count as initial contacts
@@ -119,6 +136,9 @@ ODHS_API int odhs_stepper_run_until_packing_fraction(odhs_stepper *st, double ph
 /* ---- observables (of the current state) -------------------------------- */
 ODHS_API int odhs_stepper_time(const odhs_stepper *st, double *t);
 ODHS_API int odhs_stepper_strain(const odhs_stepper *st, double *gamma);
+/** Adaptive-integrator counters: rejected steps and the current step (in tau
+ *  units); either may be NULL. */
+ODHS_API int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejected, double *h);
 /** Counters: steps, collisions, openings (any output may be NULL). */
 ODHS_API int odhs_stepper_counts(const odhs_stepper *st, uint64_t *steps, uint64_t *collisions,
                                  uint64_t *openings);
