@@ -134,7 +134,7 @@ int main(int argc, char **argv)
 
     printf("# machine: %s; libodhs %s\n", cpu, odhs_version_string());
     printf("# N = %zu 2D bidisperse, phi = 0.80, shear to strain %g, solver %s\n", n, gamma, solver);
-    setting ref = {"reference heun tol 1e-12, corr 1", ODHS_INTEGRATOR_HEUN, 1e-3, 1e-12, 1};
+    setting ref = {"reference heun tol 1e-11, corr 1", ODHS_INTEGRATOR_HEUN, 1e-3, 1e-11, 1};
     setting set[] = {
         {"paper euler dt 1e-4 corr 10", ODHS_INTEGRATOR_EULER, 1e-4, 0, 10},
         {"paper euler dt 1e-5 corr 10", ODHS_INTEGRATOR_EULER, 1e-5, 0, 10},

@@ -189,6 +189,8 @@ struct odhs_stepper {
     double h;         /* adaptive: current step in units of tau */
     double lambda;    /* mean diameter */
     double *U0, *Ua;  /* adaptive: velocities at the start, averaged (nd) */
+    double *disps;    /* adaptive: displacement record at the start (nd) */
+    double Ms[9];
     uint64_t nrejected, nsolves_pred;
     unsigned corr_every;
     double contact_tol;

@@ -572,8 +572,9 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->xs = odhs__calloc(st->nd, sizeof(double));
     st->U0 = odhs__calloc(st->nd, sizeof(double));
     st->Ua = odhs__calloc(st->nd, sizeof(double));
+    st->disps = odhs__calloc(st->nd, sizeof(double));
     int s = odhs_network_create(sys, &st->net);
-    if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || !st->U0 || !st->Ua || s) {
+    if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || !st->U0 || !st->Ua || !st->disps || s) {
         odhs_stepper_destroy(st);
         return ODHS_E_NOMEM;
     }
@@ -585,7 +586,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
 {
     if (!st) return;
     odhs_network_destroy(st->net);
-    void *arrays[] = {st->U0, st->Ua, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
+    void *arrays[] = {st->disps, st->U0, st->Ua, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
                       st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->ev};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
@@ -779,6 +780,26 @@ static int collect_events(odhs_stepper *st)
 
 static int emit_events(odhs_stepper *st, odhs_event *first, int *stop);
 
+/* back to the start of the current step before any contact changed (used by
+ * the adaptive integrator to repeat a step with a shorter length) */
+static int restart_step(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    memcpy(st->sys->x, st->xs, st->nd * sizeof *st->xs);
+    memcpy(st->sys->L, st->Ls, sizeof st->Ls);
+    st->sys->gamma = st->gammas;
+    st->time = st->times;
+    st->strain = st->strains;
+    st->nsteps = st->nsteps_s;
+    memcpy(st->disp, st->disps, st->nd * sizeof *st->disp);
+    memcpy(st->M, st->Ms, sizeof st->M);
+    memcpy(net->f, st->sf, st->snc * sizeof *net->f);
+    memcpy(st->G, st->Gs, sizeof st->G);
+    st->kappa = st->kappas;
+    odhs__net_geometry(net, st->sys);
+    return eval_forces(st);
+}
+
 /* ---- adaptive Heun --------------------------------------------------------
  * Predictor: move by tau*V0 (no collision checks: the configuration is only
  * used to evaluate velocities on the same network), solve there for V*. The
@@ -885,6 +906,12 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
             return ODHS_OK;
         }
     }
+    int relocated = 0;
+    if (st->integrator == ODHS_INTEGRATOR_HEUN) {
+        memcpy(st->disps, st->disp, st->nd * sizeof *st->disps);
+        memcpy(st->Ms, st->M, sizeof st->Ms);
+    }
+again:;
     double tplan = st->dt * st->tau;
     if (limit < tplan) tplan = limit;
     /* the chord of this step: gradient G and velocities vel */
@@ -911,6 +938,14 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     st->strain += t * st->drv->gdot;
     st->nsteps++;
     odhs_network *net = st->net;
+    if (st->integrator == ODHS_INTEGRATOR_HEUN && ci != SIZE_MAX && !relocated && t < 0.999 * tplan && t > 0.0) {
+        /* the chord was the Heun average over the planned step; repeat the
+         * step with the Heun chord of [0, t_collision] (second order) */
+        if ((s = restart_step(st))) goto fail;
+        relocated = 1;
+        limit = t * (1.0 + 1e-7);
+        goto again;
+    }
     if (ci != SIZE_MAX) {
         size_t c = odhs__net_add(net, ci, cj, ODHS_CONTACT_TEMPORARY);
         if (c == SIZE_MAX || record_change(st, ci, cj, +1)) {
@@ -920,6 +955,30 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     }
     odhs__net_geometry(net, st->sys);
     if ((s = eval_forces(st))) goto fail;
+    if (st->integrator == ODHS_INTEGRATOR_HEUN && ci == SIZE_MAX && !relocated && net->nc == st->snc) {
+        /* locate an opening inside the step: forces are smooth in time, so
+         * the first zero crossing t* = t f0/(f0 - f1) (second-order accurate)
+         * ends a repeated, shorter step, instead of the step's end */
+        int pj = 0;
+        odhs_network_potentially_jammed(net, &pj);
+        if (!pj && (s = compute_forces(st)) == ODHS_OK) {
+            double fbig = 0.0, tstar = INFINITY;
+            for (size_t c = 0; c < net->nc; ++c) fbig = fmax(fbig, fabs(net->f[c]));
+            for (size_t c = 0; c < net->nc; ++c) {
+                double f0 = st->sf[c], f1 = net->f[c];
+                if (net->kind[c] != ODHS_CONTACT_TEMPORARY || !(f1 < -EPS_F * fbig) || !(f0 > 0.0)) continue;
+                tstar = fmin(tstar, t * f0 / (f0 - f1));
+            }
+            if (tstar < 0.999 * t) {
+                if ((s = restart_step(st))) goto fail;
+                relocated = 1;
+                limit = tstar * (1.0 + 1e-9);
+                goto again;
+            }
+        } else if (s) {
+            goto fail;
+        }
+    }
     if ((s = rewire(st))) goto fail;
     if (!st->jammed && st->corr_every && st->nsteps % st->corr_every == 0) {
         int added = 0;
