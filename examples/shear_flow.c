@@ -25,7 +25,12 @@ static void usage(FILE *f)
             "  --out FILE.xyz     write the final configuration\n"
             "  --series FILE.csv  write strain,shear_stress,pressure,z,events per interval\n"
             "  --every X          output interval in strain (default 0.01)\n"
-            "  --dt X             step in strain units (default 1e-3)\n"
+            "  --dt X             step in strain units (default 1e-3; the largest step\n"
+            "                     with --integrator heun)\n"
+            "  --integrator NAME  euler (the paper's fixed step) or heun (adaptive)\n"
+            "                     (default euler)\n"
+            "  --tol X            heun: error per step relative to the mean diameter\n"
+            "                     (default 1e-6)\n"
             "  --solver NAME      linear solver: cg, dense (default cg)\n"
             "  --pressure P       shear at fixed pressure P instead of fixed volume\n"
             "  --n N              built-in scene: number of particles (default 256)\n"
@@ -110,8 +115,8 @@ static int build_scene(int dim, unsigned long n, double phi, unsigned long seed,
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *solver_name = "cg";
-    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80;
+    const char *in = NULL, *outpath = NULL, *series = NULL, *solver_name = "cg", *integrator = "euler";
+    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 1e-6;
     unsigned long n = 256, seed = 1, dim = 2;
     for (int a = 1; a < argc; ++a) {
         const char *o = argv[a];
@@ -130,6 +135,10 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--out")) outpath = v;
         else if (!strcmp(o, "--series")) series = v;
         else if (!strcmp(o, "--solver")) solver_name = v;
+        else if (!strcmp(o, "--integrator")) {
+            integrator = v;
+            bad = strcmp(v, "euler") && strcmp(v, "heun");
+        } else if (!strcmp(o, "--tol")) bad = parse_double(v, &tol) || tol <= 0 || tol >= 1;
         else if (!strcmp(o, "--strain")) bad = parse_double(v, &strain) || strain <= 0;
         else if (!strcmp(o, "--every")) bad = parse_double(v, &every) || every <= 0;
         else if (!strcmp(o, "--dt")) bad = parse_double(v, &dt) || dt <= 0;
@@ -181,6 +190,8 @@ int main(int argc, char **argv)
     if (pressure > 0) CHECK(odhs_driver_set_pressure(drv, pressure));
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
     CHECK(odhs_stepper_set_dt(st, dt));
+    CHECK(odhs_stepper_set_integrator(st, strcmp(integrator, "heun") ? ODHS_INTEGRATOR_EULER : ODHS_INTEGRATOR_HEUN));
+    CHECK(odhs_stepper_set_tolerance(st, tol));
     rc = odhs_stepper_reset(st);
     if (rc) {
         fprintf(stderr, "shear_flow: %s\n", odhs_stepper_errmsg(st));

@@ -43,5 +43,14 @@ expect_in s.csv "^strain,shear_stress,pressure,z,events" "shear_flow writes its 
 expect 0 "shear_flow at fixed pressure" -- "$bin/shear_flow" --in "$tmp/s.xyz" --strain 0.01 --pressure 5
 expect 0 "shear_flow 3D built-in" -- "$bin/shear_flow" --dim 3 --n 32 --phi 0.4 --strain 0.01
 expect 0 "shear_flow dense solver" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --solver dense
+expect 0 "shear_flow adaptive" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --integrator heun --tol 1e-8
+expect 2 "shear_flow bad integrator" -- "$bin/shear_flow" --integrator rk9
+expect 2 "shear_flow bad tol" -- "$bin/shear_flow" --tol 2
+expect 0 "jam_packing help" -- "$bin/jam_packing" --help
+expect 2 "jam_packing bad protocol" -- "$bin/jam_packing" --protocol squash
+expect 0 "jam_packing compress" -- "$bin/jam_packing" --n 32 --svg "$tmp/j.svg" --contacts "$tmp/j.con" --out "$tmp/j.xyz"
+expect_in out "jammed                 yes" "jam_packing certifies a jammed packing"
+head -c 4 "$tmp/j.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: jam_packing svg"; fail=$((fail + 1)); }
+grep -q "^# libodhs contacts" "$tmp/j.con" && pass=$((pass + 1)) || { echo "FAIL: jam_packing contacts"; fail=$((fail + 1)); }
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
