@@ -13,5 +13,6 @@
 #include "odhs/driver.h"
 #include "odhs/stepper.h"
 #include "odhs/jamming.h"
+#include "odhs/checkpoint.h"
 
 #endif /* ODHS_H */

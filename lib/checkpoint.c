@@ -1,0 +1,479 @@
+/* libodhs - checkpoints: the whole simulation state in a versioned, checksummed
+ * binary file (see include/odhs/checkpoint.h). */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "internal.h"
+
+static const char MAGIC[8] = {'O', 'D', 'H', 'S', 'C', 'K', 'P', 'T'};
+
+/* ---- byte buffer (writer) ------------------------------------------------ */
+typedef struct {
+    unsigned char *p;
+    size_t len, cap;
+    int nomem;
+} wbuf;
+
+static void put(wbuf *b, const void *src, size_t len)
+{
+    if (b->nomem) return;
+    if (b->len + len > b->cap) {
+        size_t cap = b->cap ? b->cap : 4096;
+        while (cap < b->len + len) cap *= 2;
+        unsigned char *q = odhs__realloc(b->p, cap);
+        if (!q) {
+            b->nomem = 1;
+            return;
+        }
+        b->p = q;
+        b->cap = cap;
+    }
+    memcpy(b->p + b->len, src, len);
+    b->len += len;
+}
+
+static void put_u64(wbuf *b, uint64_t v)
+{
+    unsigned char c[8];
+    for (int k = 0; k < 8; ++k) c[k] = (unsigned char)(v >> (8 * k));
+    put(b, c, 8);
+}
+
+static void put_f64(wbuf *b, double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, 8);
+    put_u64(b, u);
+}
+
+static void put_f64s(wbuf *b, const double *v, size_t n)
+{
+    for (size_t k = 0; k < n; ++k) put_f64(b, v[k]);
+}
+
+static void put_tag(wbuf *b, const char *tag) { put(b, tag, 4); }
+
+static uint64_t fnv1a(const unsigned char *p, size_t len)
+{
+    uint64_t h = 1469598103934665603ULL;
+    for (size_t k = 0; k < len; ++k) {
+        h ^= p[k];
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+/* ---- writer ----------------------------------------------------------------- */
+int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
+{
+    if (!st) return ODHS_E_NULL;
+    odhs_stepper *mst = (odhs_stepper *)st; /* error message buffer only */
+    if (!path) return odhs__err(mst->errmsg, ODHS_E_NULL, "path is NULL");
+    if (!st->ready) return odhs__err(mst->errmsg, ODHS_E_STATE, "checkpoint: the stepper has no state yet");
+    const odhs_system *sys = st->sys;
+    const odhs_driver *drv = st->drv;
+    const odhs_network *net = st->net;
+    size_t n = sys->n, nd = st->nd;
+    wbuf b = {NULL, 0, 0, 0};
+    put(&b, MAGIC, 8);
+    put_u64(&b, ODHS_CHECKPOINT_VERSION);
+    /* system */
+    put_tag(&b, "SYS ");
+    put_u64(&b, (uint64_t)sys->dim);
+    put_u64(&b, n);
+    put_f64s(&b, sys->L, 3);
+    put_f64(&b, sys->gamma);
+    put_f64s(&b, sys->x, nd);
+    put_f64s(&b, sys->r, n);
+    put(&b, sys->species, n * sizeof *sys->species);
+    /* driver */
+    put_tag(&b, "DRV ");
+    put_f64(&b, drv->xi0);
+    put_f64(&b, drv->gdot);
+    put_f64(&b, drv->crate);
+    put_u64(&b, (uint64_t)drv->pressure_on);
+    put_f64(&b, drv->p);
+    put_f64(&b, drv->kappa_max);
+    put_f64(&b, drv->tau_user);
+    put_u64(&b, drv->F ? 1u : 0u);
+    if (drv->F) put_f64s(&b, drv->F, nd);
+    /* stepper */
+    put_tag(&b, "STP ");
+    put_f64(&b, st->dt);
+    put_u64(&b, (uint64_t)st->integrator);
+    put_f64(&b, st->tol);
+    put_f64(&b, st->h);
+    put_f64(&b, st->lambda);
+    put_u64(&b, st->nrejected);
+    put_u64(&b, st->nsolves_pred);
+    put_u64(&b, st->corr_every);
+    put_f64(&b, st->contact_tol);
+    put_f64(&b, st->time);
+    put_f64(&b, st->strain);
+    put_u64(&b, st->nsteps);
+    put_u64(&b, st->ncoll);
+    put_u64(&b, st->nopen);
+    put_f64(&b, st->tau);
+    put_f64s(&b, st->G, 9);
+    put_f64(&b, st->kappa);
+    put_u64(&b, (uint64_t)st->jammed);
+    put_f64s(&b, st->U, nd);
+    put_f64(&b, st->skin);
+    put_f64(&b, st->rc);
+    put_f64s(&b, st->disp, nd);
+    put_f64s(&b, st->M, 9);
+    put_u64(&b, (uint64_t)st->nb_stale);
+    put_u64(&b, st->npairs);
+    for (size_t p = 0; p < st->npairs; ++p) {
+        put_u64(&b, st->pi[p]);
+        put_u64(&b, st->pj[p]);
+    }
+    /* network, in its order */
+    put_tag(&b, "NET ");
+    put_u64(&b, net->nc);
+    for (size_t c = 0; c < net->nc; ++c) {
+        put_u64(&b, net->ci[c]);
+        put_u64(&b, net->cj[c]);
+        put_u64(&b, (uint64_t)net->kind[c]);
+        put_f64(&b, net->f[c]);
+    }
+    put_tag(&b, "END ");
+    put_u64(&b, b.nomem ? 0 : fnv1a(b.p, b.len));
+    if (b.nomem) {
+        odhs__free(b.p);
+        return odhs__err(mst->errmsg, ODHS_E_NOMEM, "checkpoint: out of memory");
+    }
+
+    /* write atomically: temporary file in the same directory, sync, rename */
+    size_t plen = strlen(path);
+    char *tmp = odhs__malloc(plen + 16);
+    if (!tmp) {
+        odhs__free(b.p);
+        return odhs__err(mst->errmsg, ODHS_E_NOMEM, "checkpoint: out of memory");
+    }
+    snprintf(tmp, plen + 16, "%s.tmpXXXXXX", path);
+    int fd = mkstemp(tmp);
+    int ok = fd >= 0;
+    FILE *f = ok ? fdopen(fd, "wb") : NULL;
+    if (ok && !f) {
+        close(fd);
+        ok = 0;
+    }
+    int err = 0;
+    if (ok) {
+        ok = fwrite(b.p, 1, b.len, f) == b.len && fflush(f) == 0 && fsync(fileno(f)) == 0;
+        if (!ok) err = errno;
+        if (fclose(f) != 0 && ok) {
+            ok = 0;
+            err = errno;
+        }
+        if (ok && rename(tmp, path) != 0) {
+            ok = 0;
+            err = errno;
+        }
+        if (!ok) remove(tmp);
+    } else {
+        err = errno;
+    }
+    odhs__free(b.p);
+    int st_code = ok ? ODHS_OK
+                     : odhs__err(mst->errmsg, ODHS_E_IO, "checkpoint: cannot write %s: %s", path, strerror(err));
+    odhs__free(tmp);
+    return st_code;
+}
+
+/* ---- reader --------------------------------------------------------------- */
+typedef struct {
+    const unsigned char *p;
+    size_t len, pos;
+    int bad;
+} rbuf;
+
+static int get(rbuf *b, void *dst, size_t len)
+{
+    if (b->bad || len > b->len - b->pos) {
+        b->bad = 1;
+        if (dst) memset(dst, 0, len);
+        return -1;
+    }
+    if (dst) memcpy(dst, b->p + b->pos, len);
+    b->pos += len;
+    return 0;
+}
+
+static uint64_t get_u64(rbuf *b)
+{
+    unsigned char c[8];
+    if (get(b, c, 8)) return 0;
+    uint64_t v = 0;
+    for (int k = 7; k >= 0; --k) v = (v << 8) | c[k];
+    return v;
+}
+
+static double get_f64(rbuf *b)
+{
+    uint64_t u = get_u64(b);
+    double v;
+    memcpy(&v, &u, 8);
+    return v;
+}
+
+static void get_f64s(rbuf *b, double *v, size_t n)
+{
+    for (size_t k = 0; k < n; ++k) v[k] = get_f64(b);
+}
+
+static int tag(rbuf *b, const char *t)
+{
+    char c[4];
+    if (get(b, c, 4)) return -1;
+    if (memcmp(c, t, 4)) {
+        b->bad = 1;
+        return -1;
+    }
+    return 0;
+}
+
+static int finite_all(const double *v, size_t n)
+{
+    for (size_t k = 0; k < n; ++k)
+        if (!isfinite(v[k])) return 0;
+    return 1;
+}
+
+#define FAIL(code, ...)                                          \
+    do {                                                         \
+        status = odhs__err(msg, (code), __VA_ARGS__);            \
+        goto fail;                                               \
+    } while (0)
+
+int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs_system **sys_out,
+                          odhs_driver **drv_out, odhs_stepper **st_out, char *errbuf, size_t errlen)
+{
+    char msg[ODHS_ERRMSG_LEN] = "";
+    int status = ODHS_OK;
+    odhs_system *sys = NULL;
+    odhs_driver *drv = NULL;
+    odhs_stepper *st = NULL;
+    double *tmpF = NULL;
+    if (sys_out) *sys_out = NULL;
+    if (drv_out) *drv_out = NULL;
+    if (st_out) *st_out = NULL;
+    if (!buf || !solver || !sys_out || !drv_out || !st_out) {
+        status = odhs__err(msg, ODHS_E_NULL, "checkpoint: NULL argument");
+        goto fail;
+    }
+    const unsigned char *p = buf;
+    if (len < 8 + 8 + 4 + 8 || memcmp(p, MAGIC, 8)) FAIL(ODHS_E_FORMAT, "checkpoint: not a libodhs checkpoint");
+    /* checksum first: nothing is trusted before it matches */
+    {
+        rbuf t = {p, len, len - 8, 0};
+        uint64_t sum = get_u64(&t);
+        if (memcmp(p + len - 12, "END ", 4) || sum != fnv1a(p, len - 8))
+            FAIL(ODHS_E_FORMAT, "checkpoint: checksum mismatch (truncated or corrupted file)");
+    }
+    rbuf b = {p, len - 12, 8, 0};
+    uint64_t version = get_u64(&b);
+    if (version != ODHS_CHECKPOINT_VERSION)
+        FAIL(ODHS_E_FORMAT, "checkpoint: format version %llu not supported (this library reads %d)",
+             (unsigned long long)version, ODHS_CHECKPOINT_VERSION);
+    /* system */
+    if (tag(&b, "SYS ")) FAIL(ODHS_E_FORMAT, "checkpoint: system section missing");
+    uint64_t dim = get_u64(&b), n = get_u64(&b);
+    if (b.bad || (dim != 2 && dim != 3) || n == 0 || n > (len / 8) / (dim + 1))
+        FAIL(ODHS_E_FORMAT, "checkpoint: bad dimension or particle count");
+    size_t nd = (size_t)n * (size_t)dim;
+    int s = odhs_system_create((int)dim, (size_t)n, &sys);
+    if (s) FAIL(s, "checkpoint: %s", odhs_strerror(s));
+    get_f64s(&b, sys->L, 3);
+    sys->gamma = get_f64(&b);
+    get_f64s(&b, sys->x, nd);
+    get_f64s(&b, sys->r, (size_t)n);
+    get(&b, sys->species, (size_t)n * sizeof *sys->species);
+    if (b.bad) FAIL(ODHS_E_FORMAT, "checkpoint: system section truncated");
+    if (!finite_all(sys->L, 3) || !isfinite(sys->gamma) || !finite_all(sys->x, nd) || !finite_all(sys->r, (size_t)n))
+        FAIL(ODHS_E_FORMAT, "checkpoint: non-finite number in the system section");
+    double rmax = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!(sys->r[i] > 0.0)) FAIL(ODHS_E_FORMAT, "checkpoint: radius %zu is not positive", i);
+        rmax = fmax(rmax, sys->r[i]);
+        sys->species[i][ODHS_SPECIES_MAX] = '\0';
+    }
+    for (size_t k = 0; k < dim; ++k)
+        if (!(sys->L[k] >= 4.0 * rmax)) FAIL(ODHS_E_FORMAT, "checkpoint: box edge %zu too small", k);
+    if (fabs(sys->gamma) > 0.5 * sys->L[0] / sys->L[1] * (1 + 1e-12))
+        FAIL(ODHS_E_FORMAT, "checkpoint: strain outside its remapped range");
+    for (size_t i = 0; i < nd; ++i)
+        if (sys->x[i] < 0.0 || sys->x[i] >= sys->L[i % dim]) FAIL(ODHS_E_FORMAT, "checkpoint: position outside the box");
+    sys->rmax = rmax;
+    sys->has_r = sys->has_x = 1;
+    /* driver */
+    if (tag(&b, "DRV ")) FAIL(ODHS_E_FORMAT, "checkpoint: driver section missing");
+    if ((s = odhs_driver_create(&drv))) FAIL(s, "checkpoint: %s", odhs_strerror(s));
+    drv->xi0 = get_f64(&b);
+    drv->gdot = get_f64(&b);
+    drv->crate = get_f64(&b);
+    uint64_t pon = get_u64(&b);
+    drv->p = get_f64(&b);
+    drv->kappa_max = get_f64(&b);
+    drv->tau_user = get_f64(&b);
+    uint64_t hasF = get_u64(&b);
+    if (b.bad || pon > 1 || hasF > 1) FAIL(ODHS_E_FORMAT, "checkpoint: driver section malformed");
+    drv->pressure_on = (int)pon;
+    if (!(drv->xi0 > 0.0) || !isfinite(drv->xi0) || !isfinite(drv->gdot) || !isfinite(drv->crate) ||
+        !isfinite(drv->p) || !(drv->kappa_max > 0.0) || !isfinite(drv->kappa_max) || !isfinite(drv->tau_user) ||
+        drv->tau_user < 0.0 || (pon && !(drv->p > 0.0)))
+        FAIL(ODHS_E_FORMAT, "checkpoint: invalid driver settings");
+    if (hasF) {
+        tmpF = odhs__malloc_array(nd, sizeof *tmpF);
+        if (!tmpF) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
+        get_f64s(&b, tmpF, nd);
+        if (b.bad || !finite_all(tmpF, nd)) FAIL(ODHS_E_FORMAT, "checkpoint: bad driver forces");
+        if ((s = odhs_driver_set_forces(drv, (size_t)n, (int)dim, tmpF))) FAIL(s, "checkpoint: %s", odhs_strerror(s));
+    }
+    /* stepper */
+    if (tag(&b, "STP ")) FAIL(ODHS_E_FORMAT, "checkpoint: stepper section missing");
+    if ((s = odhs_stepper_create(sys, drv, solver, &st))) FAIL(s, "checkpoint: %s", odhs_strerror(s));
+    st->dt = get_f64(&b);
+    uint64_t integ = get_u64(&b);
+    st->tol = get_f64(&b);
+    st->h = get_f64(&b);
+    st->lambda = get_f64(&b);
+    st->nrejected = get_u64(&b);
+    st->nsolves_pred = get_u64(&b);
+    uint64_t corr = get_u64(&b);
+    st->contact_tol = get_f64(&b);
+    st->time = get_f64(&b);
+    st->strain = get_f64(&b);
+    st->nsteps = get_u64(&b);
+    st->ncoll = get_u64(&b);
+    st->nopen = get_u64(&b);
+    st->tau = get_f64(&b);
+    get_f64s(&b, st->G, 9);
+    st->kappa = get_f64(&b);
+    uint64_t jam = get_u64(&b);
+    get_f64s(&b, st->U, nd);
+    st->skin = get_f64(&b);
+    st->rc = get_f64(&b);
+    get_f64s(&b, st->disp, nd);
+    get_f64s(&b, st->M, 9);
+    uint64_t stale = get_u64(&b);
+    uint64_t npairs = get_u64(&b);
+    if (b.bad || integ > ODHS_INTEGRATOR_HEUN || corr > 0xffffffffu || jam > 1 || stale > 1 ||
+        npairs > (b.len - b.pos) / 16)
+        FAIL(ODHS_E_FORMAT, "checkpoint: stepper section malformed");
+    st->integrator = (int)integ;
+    st->corr_every = (unsigned)corr;
+    st->jammed = (int)jam;
+    st->nb_stale = (int)stale;
+    double sc[] = {st->dt, st->tol, st->h, st->lambda, st->contact_tol, st->time, st->strain, st->tau,
+                   st->kappa, st->skin, st->rc};
+    if (!finite_all(sc, sizeof sc / sizeof sc[0]) || !finite_all(st->G, 9) || !finite_all(st->M, 9) ||
+        !finite_all(st->U, nd) || !finite_all(st->disp, nd) || !(st->dt > 0) || !(st->tol > 0 && st->tol < 1) ||
+        !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) || !(st->skin > 0) || st->contact_tol < 0)
+        FAIL(ODHS_E_FORMAT, "checkpoint: invalid stepper values");
+    if (npairs) {
+        size_t *a = odhs__realloc(st->pi, (size_t)npairs * sizeof *a);
+        if (a) st->pi = a;
+        size_t *c = odhs__realloc(st->pj, (size_t)npairs * sizeof *c);
+        if (c) st->pj = c;
+        if (!a || !c) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
+        st->pcap = (size_t)npairs;
+    }
+    for (size_t q = 0; q < npairs; ++q) {
+        uint64_t i = get_u64(&b), j = get_u64(&b);
+        if (b.bad || i >= j || j >= n) FAIL(ODHS_E_FORMAT, "checkpoint: bad neighbour pair");
+        st->pi[q] = (size_t)i;
+        st->pj[q] = (size_t)j;
+    }
+    st->npairs = (size_t)npairs;
+    /* network */
+    if (tag(&b, "NET ")) FAIL(ODHS_E_FORMAT, "checkpoint: network section missing");
+    uint64_t nc = get_u64(&b);
+    if (b.bad || nc > (b.len - b.pos) / 32) FAIL(ODHS_E_FORMAT, "checkpoint: bad contact count");
+    for (size_t c = 0; c < nc; ++c) {
+        uint64_t i = get_u64(&b), j = get_u64(&b), kind = get_u64(&b);
+        double f = get_f64(&b);
+        if (b.bad || i >= j || j >= n || kind > ODHS_CONTACT_PERMANENT || !isfinite(f))
+            FAIL(ODHS_E_FORMAT, "checkpoint: bad contact %zu", c);
+        if (odhs__net_find(st->net, (size_t)i, (size_t)j) != SIZE_MAX)
+            FAIL(ODHS_E_FORMAT, "checkpoint: duplicate contact (%llu,%llu)", (unsigned long long)i,
+                 (unsigned long long)j);
+        size_t k = odhs__net_add(st->net, (size_t)i, (size_t)j, (int)kind);
+        if (k == SIZE_MAX) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
+        st->net->f[k] = f;
+    }
+    if (b.pos != b.len) FAIL(ODHS_E_FORMAT, "checkpoint: unexpected trailing data");
+    odhs__net_geometry(st->net, sys);
+    if (drv->F) {
+        memcpy(st->F, drv->F, nd * sizeof *st->F);
+        st->has_F = 1;
+    }
+    st->drv_version = drv->version;
+    st->ready = 1;
+    odhs__free(tmpF);
+    *sys_out = sys;
+    *drv_out = drv;
+    *st_out = st;
+    return ODHS_OK;
+fail:
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+    odhs__free(tmpF);
+    if (errbuf && errlen) snprintf(errbuf, errlen, "%s", msg);
+    return status;
+}
+
+int odhs_checkpoint_read(const char *path, odhs_solver *solver, odhs_system **sys, odhs_driver **drv,
+                         odhs_stepper **st, char *errbuf, size_t errlen)
+{
+    if (sys) *sys = NULL;
+    if (drv) *drv = NULL;
+    if (st) *st = NULL;
+    if (!path) {
+        if (errbuf && errlen) snprintf(errbuf, errlen, "checkpoint: path is NULL");
+        return ODHS_E_NULL;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        if (errbuf && errlen) snprintf(errbuf, errlen, "checkpoint: cannot open %s: %s", path, strerror(errno));
+        return ODHS_E_IO;
+    }
+    size_t cap = 1 << 16, len = 0;
+    unsigned char *buf = odhs__malloc(cap);
+    int status = ODHS_OK;
+    while (buf) {
+        if (len == cap) {
+            unsigned char *q = odhs__realloc(buf, cap * 2);
+            if (!q) {
+                odhs__free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = q;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - len, f);
+        len += got;
+        if (got == 0) break;
+    }
+    if (!buf) status = ODHS_E_NOMEM;
+    else if (ferror(f)) status = ODHS_E_IO;
+    fclose(f);
+    if (status) {
+        if (errbuf && errlen)
+            snprintf(errbuf, errlen, "checkpoint: %s reading %s", status == ODHS_E_NOMEM ? "out of memory" : "I/O error",
+                     path);
+        odhs__free(buf);
+        return status;
+    }
+    status = odhs_checkpoint_parse(buf, len, solver, sys, drv, st, errbuf, errlen);
+    odhs__free(buf);
+    return status;
+}

@@ -1,0 +1,295 @@
+/* Check suite "checkpoint": save/restore of a whole simulation. */
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "odhs.h"
+
+static char dir[64];
+
+static void setup(void)
+{
+    snprintf(dir, sizeof dir, "/tmp/odhs_ckpt_XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+}
+
+static void teardown(void)
+{
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    if (system(cmd)) { /* best effort */
+    }
+}
+
+static odhs_system *scene(int dim, size_t n, double phi, unsigned seed)
+{
+    odhs_system *sys;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    ck_assert_int_eq(odhs_system_create(dim, n, &sys), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed), ODHS_OK);
+    ck_assert_int_eq(odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.3, seed + 1), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_compression_rate(drv, 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_run_until_packing_fraction(st, phi), ODHS_OK);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    return sys;
+}
+
+typedef struct {
+    double t[4096];
+    size_t i[4096], j[4096];
+    int kind[4096];
+    size_t n;
+} evlog;
+
+static int log_event(const odhs_event *ev, void *ctx)
+{
+    evlog *l = ctx;
+    if (l->n < 4096) {
+        l->t[l->n] = ev->time;
+        l->i[l->n] = ev->i;
+        l->j[l->n] = ev->j;
+        l->kind[l->n] = ev->kind;
+        l->n++;
+    }
+    return 0;
+}
+
+/* final state fingerprint */
+typedef struct {
+    double *x, *f;
+    size_t nc;
+    double t, g;
+    uint64_t steps, ncoll, nopen;
+} state;
+
+static void grab(odhs_stepper *st, odhs_system *sys, state *s)
+{
+    size_t nd = odhs_system_count(sys) * (size_t)odhs_system_dim(sys);
+    s->x = malloc(nd * sizeof *s->x);
+    ck_assert_int_eq(odhs_system_get_positions(sys, s->x), ODHS_OK);
+    const odhs_network *net = odhs_stepper_network(st);
+    s->nc = odhs_network_count(net);
+    s->f = malloc((s->nc + 1) * sizeof *s->f);
+    ck_assert_int_eq(odhs_network_get_forces(net, s->f), ODHS_OK);
+    odhs_stepper_time(st, &s->t);
+    odhs_stepper_strain(st, &s->g);
+    odhs_stepper_counts(st, &s->steps, &s->ncoll, &s->nopen);
+}
+
+static void run_and_compare(int dim, int integrator, const char *solver, int pressure)
+{
+    odhs_system *base = scene(dim, dim == 2 ? 48 : 40, dim == 2 ? 0.74 : 0.5, 9);
+    char path[128];
+    snprintf(path, sizeof path, "%s/run.ckpt", dir);
+    /* uninterrupted run A, with a checkpoint written half-way */
+    odhs_system *sa;
+    odhs_solver *sol;
+    odhs_driver *da;
+    odhs_stepper *a;
+    ck_assert_int_eq(odhs_system_clone(base, &sa), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name(solver, &sol), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&da), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_shear_rate(da, 1.0), ODHS_OK);
+    if (pressure) ck_assert_int_eq(odhs_driver_set_pressure(da, 2.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(sa, da, sol, &a), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_integrator(a, integrator), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_correction_interval(a, 7), ODHS_OK);
+    evlog *la = calloc(1, sizeof *la), *lb = calloc(1, sizeof *lb);
+    ck_assert_int_eq(odhs_stepper_set_event_callback(a, log_event, la), ODHS_OK);
+    for (int k = 0; k < 60; ++k) ck_assert_int_eq(odhs_stepper_step(a, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_checkpoint_write(a, path), ODHS_OK);
+    size_t mark = la->n;
+    for (int k = 0; k < 60; ++k) ck_assert_int_eq(odhs_stepper_step(a, NULL), ODHS_OK);
+    state A;
+    grab(a, sa, &A);
+    /* run B: restored from the checkpoint */
+    odhs_system *sb;
+    odhs_driver *db;
+    odhs_stepper *b;
+    char err[256];
+    int rc = odhs_checkpoint_read(path, sol, &sb, &db, &b, err, sizeof err);
+    ck_assert_msg(rc == ODHS_OK, "read: %s", err);
+    ck_assert_int_eq(odhs_stepper_set_event_callback(b, log_event, lb), ODHS_OK);
+    for (int k = 0; k < 60; ++k) ck_assert_int_eq(odhs_stepper_step(b, NULL), ODHS_OK);
+    state B;
+    grab(b, sb, &B);
+    size_t nd = odhs_system_count(sa) * (size_t)dim;
+    ck_assert_msg(!memcmp(A.x, B.x, nd * sizeof *A.x), "positions differ after restore");
+    ck_assert_uint_eq(A.nc, B.nc);
+    ck_assert_msg(!memcmp(A.f, B.f, A.nc * sizeof *A.f), "forces differ after restore");
+    ck_assert_msg(A.t == B.t && A.g == B.g, "time/strain differ");
+    ck_assert(A.steps == B.steps && A.ncoll == B.ncoll && A.nopen == B.nopen);
+    ck_assert_uint_eq(la->n - mark, lb->n);
+    for (size_t e = 0; e < lb->n; ++e) {
+        ck_assert(la->t[mark + e] == lb->t[e]);
+        ck_assert(la->i[mark + e] == lb->i[e] && la->j[mark + e] == lb->j[e] && la->kind[mark + e] == lb->kind[e]);
+    }
+    ck_assert_msg(lb->n > 0, "no events in the second half: the test would not exercise rewiring");
+    free(A.x);
+    free(A.f);
+    free(B.x);
+    free(B.f);
+    free(la);
+    free(lb);
+    odhs_stepper_destroy(a);
+    odhs_stepper_destroy(b);
+    odhs_driver_destroy(da);
+    odhs_driver_destroy(db);
+    odhs_system_destroy(sa);
+    odhs_system_destroy(sb);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(base);
+}
+
+START_TEST(test_bit_identical_euler_2d) { run_and_compare(2, ODHS_INTEGRATOR_EULER, "cg", 0); }
+END_TEST
+START_TEST(test_bit_identical_heun_2d) { run_and_compare(2, ODHS_INTEGRATOR_HEUN, "dense", 0); }
+END_TEST
+START_TEST(test_bit_identical_pressure_2d) { run_and_compare(2, ODHS_INTEGRATOR_EULER, "dense", 1); }
+END_TEST
+START_TEST(test_bit_identical_3d) { run_and_compare(3, ODHS_INTEGRATOR_EULER, "cg", 0); }
+END_TEST
+
+/* a small valid checkpoint in memory */
+static unsigned char *make_ckpt(size_t *len, odhs_solver **solp)
+{
+    odhs_system *sys = scene(2, 16, 0.6, 3);
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    double F[32];
+    for (int k = 0; k < 32; ++k) F[k] = 0.1 * sin(k);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_forces(drv, 16, 2, F), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+    for (int k = 0; k < 10; ++k) ck_assert_int_eq(odhs_stepper_step(st, NULL), ODHS_OK);
+    char path[128];
+    snprintf(path, sizeof path, "%s/small.ckpt", dir);
+    ck_assert_int_eq(odhs_checkpoint_write(st, path), ODHS_OK);
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    unsigned char *buf = malloc(1 << 20);
+    *len = fread(buf, 1, 1 << 20, f);
+    fclose(f);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+    *solp = sol;
+    return buf;
+}
+
+START_TEST(test_truncated_and_corrupted)
+{
+    size_t len;
+    odhs_solver *sol;
+    unsigned char *buf = make_ckpt(&len, &sol);
+    odhs_system *s;
+    odhs_driver *d;
+    odhs_stepper *st;
+    char err[256];
+    ck_assert_int_eq(odhs_checkpoint_parse(buf, len, sol, &s, &d, &st, err, sizeof err), ODHS_OK);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(d);
+    odhs_system_destroy(s);
+    /* every truncation is rejected, with no handle */
+    for (size_t cut = 0; cut < len; cut += (cut < 64 ? 1 : 37)) {
+        int rc = odhs_checkpoint_parse(buf, cut, sol, &s, &d, &st, err, sizeof err);
+        ck_assert_msg(rc == ODHS_E_FORMAT, "truncated to %zu: %d", cut, rc);
+        ck_assert(s == NULL && d == NULL && st == NULL);
+        ck_assert_str_ne(err, "");
+    }
+    /* every single-byte corruption is caught by the checksum */
+    for (size_t k = 0; k < len; k += 13) {
+        buf[k] ^= 0x5a;
+        int rc = odhs_checkpoint_parse(buf, len, sol, &s, &d, &st, err, sizeof err);
+        ck_assert_msg(rc == ODHS_E_FORMAT, "corrupted byte %zu accepted", k);
+        ck_assert(s == NULL && d == NULL && st == NULL);
+        buf[k] ^= 0x5a;
+    }
+    /* NULL arguments */
+    ck_assert_int_eq(odhs_checkpoint_parse(NULL, len, sol, &s, &d, &st, err, sizeof err), ODHS_E_NULL);
+    ck_assert_int_eq(odhs_checkpoint_parse(buf, len, NULL, &s, &d, &st, NULL, 0), ODHS_E_NULL);
+    ck_assert_int_eq(odhs_checkpoint_read(NULL, sol, &s, &d, &st, err, sizeof err), ODHS_E_NULL);
+    char path[128];
+    snprintf(path, sizeof path, "%s/missing.ckpt", dir);
+    ck_assert_int_eq(odhs_checkpoint_read(path, sol, &s, &d, &st, err, sizeof err), ODHS_E_IO);
+    ck_assert(strstr(err, "missing.ckpt") != NULL);
+    free(buf);
+    odhs_solver_destroy(sol);
+}
+END_TEST
+
+START_TEST(test_atomic_write)
+{
+    size_t len;
+    odhs_solver *sol;
+    unsigned char *buf = make_ckpt(&len, &sol);
+    odhs_system *s;
+    odhs_driver *d;
+    odhs_stepper *st;
+    ck_assert_int_eq(odhs_checkpoint_parse(buf, len, sol, &s, &d, &st, NULL, 0), ODHS_OK);
+    /* a write that cannot happen leaves no file and an error */
+    ck_assert_int_eq(odhs_checkpoint_write(st, "/nonexistent-dir/x.ckpt"), ODHS_E_IO);
+    ck_assert_str_ne(odhs_stepper_errmsg(st), "");
+    /* overwriting an existing checkpoint replaces it whole; no temporary is left */
+    char path[128];
+    snprintf(path, sizeof path, "%s/small.ckpt", dir);
+    ck_assert_int_eq(odhs_stepper_step(st, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_checkpoint_write(st, path), ODHS_OK);
+    odhs_system *s2;
+    odhs_driver *d2;
+    odhs_stepper *st2;
+    ck_assert_int_eq(odhs_checkpoint_read(path, sol, &s2, &d2, &st2, NULL, 0), ODHS_OK);
+    double t1, t2;
+    odhs_stepper_time(st, &t1);
+    odhs_stepper_time(st2, &t2);
+    ck_assert(t1 == t2);
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "ls %s | grep -q tmp", dir);
+    ck_assert_msg(system(cmd) != 0, "a temporary file was left behind");
+    /* a stepper without state cannot be saved */
+    odhs_stepper *fresh;
+    ck_assert_int_eq(odhs_stepper_create(s2, d2, sol, &fresh), ODHS_OK);
+    ck_assert_int_eq(odhs_checkpoint_write(fresh, path), ODHS_E_STATE);
+    ck_assert_int_eq(odhs_checkpoint_write(NULL, path), ODHS_E_NULL);
+    ck_assert_int_eq(odhs_checkpoint_write(st, NULL), ODHS_E_NULL);
+    odhs_stepper_destroy(fresh);
+    odhs_stepper_destroy(st2);
+    odhs_driver_destroy(d2);
+    odhs_system_destroy(s2);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(d);
+    odhs_system_destroy(s);
+    free(buf);
+    odhs_solver_destroy(sol);
+}
+END_TEST
+
+Suite *make_checkpoint_suite(void)
+{
+    Suite *s = suite_create("checkpoint");
+    TCase *tc = tcase_create("checkpoint");
+    tcase_add_checked_fixture(tc, setup, teardown);
+    tcase_set_timeout(tc, 300);
+    tcase_add_test(tc, test_bit_identical_euler_2d);
+    tcase_add_test(tc, test_bit_identical_heun_2d);
+    tcase_add_test(tc, test_bit_identical_pressure_2d);
+    tcase_add_test(tc, test_bit_identical_3d);
+    tcase_add_test(tc, test_truncated_and_corrupted);
+    tcase_add_test(tc, test_atomic_write);
+    suite_add_tcase(s, tc);
+    return s;
+}
