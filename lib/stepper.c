@@ -793,7 +793,7 @@ static int restart_step(odhs_stepper *st)
     st->nsteps = st->nsteps_s;
     memcpy(st->disp, st->disps, st->nd * sizeof *st->disp);
     memcpy(st->M, st->Ms, sizeof st->M);
-    memcpy(net->f, st->sf, st->snc * sizeof *net->f);
+    if (st->snc) memcpy(net->f, st->sf, st->snc * sizeof *net->f);
     memcpy(st->G, st->Gs, sizeof st->G);
     st->kappa = st->kappas;
     odhs__net_geometry(net, st->sys);
