@@ -65,6 +65,18 @@ typedef struct odhs_solver_type {
  *  0 = 10*Nc + 100). Statistics: "iterations". Warm-started from the previous
  *  forces by the stepper. */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cg;
+/** SuiteSparseQR on A = S^T (only in builds with SuiteSparse; otherwise
+ *  "spqr" gives ODHS_E_NOTINSTALLED): solve_ls computes the least-squares
+ *  forces from Q^T g and R without forming N (the error grows with cond(S^T),
+ *  not its square); solve uses x = E R^-1 R^-T E^T b. Rank detection: a
+ *  numerical rank below Nc (a hyperstatic network: S^T has a null space)
+ *  makes setup fail with ODHS_E_SINGULAR. Parameters: "tol" (rank tolerance;
+ *  <= -2: SPQR's default 20 (m+n) eps max|col|; in (-2,0): off; >= 0:
+ *  absolute), "ordering" (SPQR ordering 0-9 except 3). Statistics: "rank",
+ *  "nc", "rank_deficiency", "tol_used", "symbolic", "numeric",
+ *  "ordering_used". The symbolic analysis is kept while the contact pairs
+ *  are unchanged. */
+ODHS_API extern const odhs_solver_type odhs_solver_type_spqr;
 /** Dense Cholesky of N through LAPACK dpotrf/dpotrs. Reports a non-positive
  *  pivot, or a reciprocal condition estimate (dpocon) below "min_rcond"
  *  (parameter, default 1e-14), as ODHS_E_SINGULAR: singular or hyperstatic
@@ -90,11 +102,15 @@ ODHS_API const char *odhs_solver_name(const odhs_solver *s);
 ODHS_API int odhs_solver_set_param(odhs_solver *s, const char *key, double value);
 /**
  * Statistics: "iterations" (backend), "residual" (relative residual
- * |N x - b| / |b| of the last solve, computed by the library), "solves" (count).
+ * |N x - b| / |b| of the last solve, computed by the library),
+ * "backward_error" (|N x - b| / (|N| |x| + |b|) with |N| bounded by twice the
+ * largest particle degree), "solves" (count).
  */
 ODHS_API int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value);
-/** Set the relative residual above which a solve is reported as failed
- *  (default 1e-6; ODHS_E_NOCONV for iterative, ODHS_E_SINGULAR for direct). */
+/** Set the normwise backward error above which a solve is reported as failed
+ *  (default 1e-6; ODHS_E_NOCONV for iterative, ODHS_E_SINGULAR for direct).
+ *  The backward error, not the relative residual, is checked: close to
+ *  jamming a good solution has a relative residual of order eps cond(N). */
 ODHS_API int odhs_solver_set_check_tolerance(odhs_solver *s, double tol);
 /**
  * Iterative refinement for direct (non-iterative) backends: after a solve

@@ -24,8 +24,10 @@
  * on the pattern, that is on the list of contact pairs: it is kept while the
  * pairs are unchanged and only the numeric factorization is redone
  * (SuiteSparseQR_C_symbolic once, SuiteSparseQR_C_numeric per setup). This
- * route does not exploit singletons (SuiteSparseQR_C_factorize would), which
- * costs little here: columns of S^T have 2*dim entries and few are singletons.
+ * route does not exploit singletons (SuiteSparseQR_C_factorize would; here
+ * they come only from particles with a single contact). A rank-deficient
+ * factorization is discarded whole (see spqr_setup), so the setup after a
+ * singular one analyses again.
  *
  * Parameters: "tol" (rank tolerance: <= -2 SuiteSparseQR's default
  * 20 (m+n) eps max_j |A_j|, the default; in (-2,0) no rank detection; >= 0
@@ -236,7 +238,14 @@ static int spqr_setup(void *state, const odhs_network *net)
     s->nnum += 1.0;
     s->rank = (double)s->cc.SPQR_istat[4];
     s->tol_used = s->cc.SPQR_tol_used;
-    if (s->cc.SPQR_istat[4] < (SuiteSparse_long)nc) return ODHS_E_SINGULAR;
+    if (s->cc.SPQR_istat[4] < (SuiteSparse_long)nc) {
+        /* A rank-deficient factorization leaves the map from the squeezed R
+         * (QR->Rmap) in the object; SuiteSparseQR_numeric only rebuilds it
+         * when the next factorization is rank deficient too, and the
+         * triangular solves use it whenever it is there. Start afresh. */
+        drop_factor(s);
+        return ODHS_E_SINGULAR;
+    }
     s->factored = 1;
     return ODHS_OK;
 }
