@@ -12,6 +12,8 @@
 
 #include <odhs.h>
 
+#include "cli.h"
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -31,26 +33,6 @@ static void usage(FILE *f)
             "  --help             this message\n"
             "The built-in scene is 50:50 bidisperse (radii 0.5/0.7, 3%% polydispersity) placed\n"
             "at random at phi = 0.45 (2D) or 0.30 (3D).\n");
-}
-
-static int parse_double(const char *s, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || end == s || *end || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
-
-static int parse_ulong(const char *s, unsigned long *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (errno || end == s || *end || s[0] == '-') return -1;
-    *out = v;
-    return 0;
 }
 
 int main(int argc, char **argv)
@@ -80,12 +62,12 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--out")) outpath = v;
         else if (!strcmp(o, "--series")) series = v;
         else if (!strcmp(o, "--solver")) solver_name = v;
-        else if (!strcmp(o, "--phi")) bad = parse_double(v, &phi_target) || phi_target <= 0 || phi_target >= 1;
-        else if (!strcmp(o, "--every")) bad = parse_double(v, &every) || every <= 0;
-        else if (!strcmp(o, "--dt")) bad = parse_double(v, &dt) || dt <= 0;
-        else if (!strcmp(o, "--n")) bad = parse_ulong(v, &n) || n < 2;
-        else if (!strcmp(o, "--seed")) bad = parse_ulong(v, &seed);
-        else if (!strcmp(o, "--dim")) bad = parse_ulong(v, &dim) || (dim != 2 && dim != 3);
+        else if (!strcmp(o, "--phi")) bad = cli_double(v, &phi_target) || phi_target <= 0 || phi_target >= 1;
+        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
+        else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
+        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
+        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
+        else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
         else {
             fprintf(stderr, "compress: unknown option %s\n", o);
             usage(stderr);
@@ -109,9 +91,7 @@ int main(int argc, char **argv)
             return 1;
         }
     } else {
-        if ((rc = odhs_system_create((int)dim, n, &sys)) ||
-            (rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed)) ||
-            (rc = odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.30, seed + 1))) {
+        if ((rc = cli_scene((int)dim, n, seed, 1.0, &sys))) {
             fprintf(stderr, "compress: building the scene: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
             return 1;
         }

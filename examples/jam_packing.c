@@ -14,6 +14,8 @@
 
 #include <odhs.h>
 
+#include "cli.h"
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -35,26 +37,6 @@ static void usage(FILE *f)
             "shear with compression at 1/5 of the shear rate; pressure = shear at fixed\n"
             "pressure, doubled every 0.05 strain (towards zero strain rate).\n"
             "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed.\n");
-}
-
-static int parse_double(const char *s, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || end == s || *end || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
-
-static int parse_ulong(const char *s, unsigned long *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (errno || end == s || *end || s[0] == '-') return -1;
-    *out = v;
-    return 0;
 }
 
 /* drive with the given driver until jammed (or failure / strain budget) */
@@ -105,11 +87,11 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--contacts")) contacts = v;
         else if (!strcmp(o, "--svg")) svg = v;
         else if (!strcmp(o, "--solver")) solver_name = v;
-        else if (!strcmp(o, "--dt")) bad = parse_double(v, &dt) || dt <= 0;
-        else if (!strcmp(o, "--max-strain")) bad = parse_double(v, &max_strain) || max_strain <= 0;
-        else if (!strcmp(o, "--n")) bad = parse_ulong(v, &n) || n < 2;
-        else if (!strcmp(o, "--seed")) bad = parse_ulong(v, &seed);
-        else if (!strcmp(o, "--dim")) bad = parse_ulong(v, &dim) || (dim != 2 && dim != 3);
+        else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
+        else if (!strcmp(o, "--max-strain")) bad = cli_double(v, &max_strain) || max_strain <= 0;
+        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
+        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
+        else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
         else {
             fprintf(stderr, "jam_packing: unknown option %s\n", o);
             usage(stderr);
@@ -130,9 +112,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "jam_packing: cannot read %s: %s\n", in, err);
             return 1;
         }
-    } else if ((rc = odhs_system_create((int)dim, n, &sys)) ||
-               (rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed)) ||
-               (rc = odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.30, seed + 1))) {
+    } else if ((rc = cli_scene((int)dim, n, seed, 1.0, &sys))) {
         fprintf(stderr, "jam_packing: building the scene: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
         return 1;
     }

@@ -16,6 +16,8 @@
 
 #include <odhs.h>
 
+#include "cli.h"
+
 static void usage(FILE *f)
 {
     fprintf(f,
@@ -42,26 +44,6 @@ static void usage(FILE *f)
             "stresses in units of gammadot/xi0 (2D: per length, 3D: per area).\n");
 }
 
-static int parse_double(const char *s, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || end == s || *end || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
-
-static int parse_ulong(const char *s, unsigned long *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long v = strtoul(s, &end, 10);
-    if (errno || end == s || *end || s[0] == '-') return -1;
-    *out = v;
-    return 0;
-}
-
 #define CHECK(call)                                                                             \
     do {                                                                                        \
         int rc_ = (call);                                                                       \
@@ -76,14 +58,12 @@ static int parse_ulong(const char *s, unsigned long *out)
 static int build_scene(int dim, unsigned long n, double phi, unsigned long seed, odhs_solver *solver,
                        odhs_system **out)
 {
-    odhs_system *sys;
-    CHECK(odhs_system_create(dim, n, &sys));
-    CHECK(odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed));
+    odhs_system *sys = NULL;
     double phi0 = dim == 2 ? 0.45 : 0.3;
     if (phi < phi0) phi0 = phi;
-    int rc = odhs_system_place_random(sys, phi0, seed + 1);
+    int rc = cli_scene(dim, n, seed, phi, &sys);
     if (rc) {
-        fprintf(stderr, "shear_flow: %s\n", odhs_system_errmsg(sys));
+        fprintf(stderr, "shear_flow: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
         return 1;
     }
     if (phi > phi0) {
@@ -138,15 +118,15 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--integrator")) {
             integrator = v;
             bad = strcmp(v, "euler") && strcmp(v, "heun");
-        } else if (!strcmp(o, "--tol")) bad = parse_double(v, &tol) || tol <= 0 || tol >= 1;
-        else if (!strcmp(o, "--strain")) bad = parse_double(v, &strain) || strain <= 0;
-        else if (!strcmp(o, "--every")) bad = parse_double(v, &every) || every <= 0;
-        else if (!strcmp(o, "--dt")) bad = parse_double(v, &dt) || dt <= 0;
-        else if (!strcmp(o, "--pressure")) bad = parse_double(v, &pressure) || pressure <= 0;
-        else if (!strcmp(o, "--phi")) bad = parse_double(v, &phi) || phi <= 0 || phi >= 1;
-        else if (!strcmp(o, "--n")) bad = parse_ulong(v, &n) || n < 2;
-        else if (!strcmp(o, "--seed")) bad = parse_ulong(v, &seed);
-        else if (!strcmp(o, "--dim")) bad = parse_ulong(v, &dim) || (dim != 2 && dim != 3);
+        } else if (!strcmp(o, "--tol")) bad = cli_double(v, &tol) || tol <= 0 || tol >= 1;
+        else if (!strcmp(o, "--strain")) bad = cli_double(v, &strain) || strain <= 0;
+        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
+        else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
+        else if (!strcmp(o, "--pressure")) bad = cli_double(v, &pressure) || pressure <= 0;
+        else if (!strcmp(o, "--phi")) bad = cli_double(v, &phi) || phi <= 0 || phi >= 1;
+        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
+        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
+        else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
         else {
             fprintf(stderr, "shear_flow: unknown option %s\n", o);
             usage(stderr);
