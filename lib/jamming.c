@@ -269,8 +269,11 @@ static int cert_ov_cb(size_t i, size_t j, const double *rij, double gap, void *v
 int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert)
 {
     if (!st) return ODHS_E_NULL;
-    if (!cert) return odhs__neterr(st->net, ODHS_E_NULL, "certificate pointer is NULL");
-    if (cert->size < sizeof(size_t)) return ODHS_E_INVALID;
+    char *msg = ((odhs_stepper *)st)->errmsg; /* logically mutable */
+    if (!cert) return odhs__err(msg, ODHS_E_NULL, "certificate pointer is NULL");
+    if (cert->size < sizeof(size_t))
+        return odhs__err(msg, ODHS_E_INVALID, "certificate size %zu: set size = sizeof(odhs_jam_certificate)",
+                         cert->size);
     const odhs_system *sys = st->sys;
     const odhs_network *net = st->net;
     odhs_jam_certificate c;

@@ -46,6 +46,8 @@ int odhs_solver_create_by_name(const char *name, odhs_solver **out)
     if (!strcmp(name, "dense")) return odhs_solver_create(&odhs_solver_type_dense, out);
 #ifdef ODHS_HAVE_SUITESPARSE
     if (!strcmp(name, "spqr")) return odhs_solver_create(&odhs_solver_type_spqr, out);
+    if (!strcmp(name, "cholmod")) return odhs_solver_create(&odhs_solver_type_cholmod, out);
+    if (!strcmp(name, "cholmod-pcg")) return odhs_solver_create(&odhs_solver_type_cholmod_pcg, out);
 #endif
     if (!strcmp(name, "cholmod") || !strcmp(name, "spqr") || !strcmp(name, "auto") || !strcmp(name, "cholmod-pcg"))
         return ODHS_E_NOTINSTALLED;
@@ -180,6 +182,12 @@ static int solve_any(odhs_solver *s, const odhs_network *net, const double *b, c
         s->last_sum = sum;
     }
     if (!(s->type->flags & ODHS_SOLVER_USES_GUESS)) memset(x, 0, nc * sizeof *x);
+    else
+        for (size_t c = 0; c < nc; ++c)
+            if (!isfinite(x[c])) { /* an unusable guess: start from zero */
+                memset(x, 0, nc * sizeof *x);
+                break;
+            }
     if (g && s->type->version >= 2 && s->type->solve_ls) st = s->type->solve_ls(s->state, net, g, x);
     else st = s->type->solve(s->state, net, b, x);
     s->nsolves += 1.0;

@@ -130,13 +130,19 @@ static int check_radii(const odhs_system *sys, const double *r, double *rmax)
     return ODHS_OK;
 }
 
-static int check_positions(const odhs_system *sys, const double *x)
+static int check_positions(const odhs_system *sys, const double *L, const double *x)
 {
     size_t nd = sys->n * (size_t)sys->dim;
-    for (size_t k = 0; k < nd; ++k)
+    for (size_t k = 0; k < nd; ++k) {
         if (!isfinite(x[k]))
             return odhs__syserr(sys, ODHS_E_NONFINITE, "coordinate %d of particle %zu is not finite",
                                 (int)(k % sys->dim), k / sys->dim);
+        /* beyond 2^50 box lengths the periodic image cannot be found exactly */
+        if (fabs(x[k]) > 0x1p50 * L[k % sys->dim])
+            return odhs__syserr(sys, ODHS_E_INVALID,
+                                "coordinate %d of particle %zu = %g is too far outside the box to wrap exactly",
+                                (int)(k % sys->dim), k / sys->dim, x[k]);
+    }
     return ODHS_OK;
 }
 
@@ -160,12 +166,14 @@ static int commit(odhs_system *sys, const double *L, double gamma, double *r, in
     int st;
     double rmax = 0.0;
     if (!isfinite(gamma)) return odhs__syserr(sys, ODHS_E_NONFINITE, "strain is not finite");
+    if (fabs(gamma) > 0x1p50 * (L[0] / L[1]))
+        return odhs__syserr(sys, ODHS_E_INVALID, "strain %g is too large to remap exactly", gamma);
     gamma = odhs__remap_strain(gamma, L);
     if (has_r && (st = check_radii(sys, r, &rmax))) return st;
     /* the box must hold two largest diameters once particles are placed */
     if ((st = check_box(sys, L, (has_r && has_x) ? rmax : 0.0))) return st;
     if (has_x) {
-        if ((st = check_positions(sys, x))) return st;
+        if ((st = check_positions(sys, L, x))) return st;
         for (size_t i = 0; i < sys->n; ++i) odhs__wrap(sys->dim, L, gamma, x + i * sys->dim);
     }
     if (has_r && has_x && (st = check_overlaps(sys, L, gamma, r, rmax, x, -1.0))) return st;
@@ -377,7 +385,7 @@ int odhs_system_validate(const odhs_system *sys, double tol)
     int st;
     if ((st = check_radii(sys, sys->r, &rmax))) return st;
     if ((st = check_box(sys, sys->L, rmax))) return st;
-    if ((st = check_positions(sys, sys->x))) return st;
+    if ((st = check_positions(sys, sys->L, sys->x))) return st;
     return check_overlaps(sys, sys->L, sys->gamma, sys->r, rmax, sys->x, tol);
 }
 

@@ -723,8 +723,8 @@ START_TEST(test_create_by_name)
     odhs_solver_destroy(s);
     s = sv_by_name("dense");
     odhs_solver_destroy(s);
-    const char *absent[2] = {"cholmod", "spqr"};
-    for (int k = 0; k < 2; ++k) {
+    const char *absent[3] = {"cholmod", "spqr", "cholmod-pcg"};
+    for (int k = 0; k < 3; ++k) {
         s = (odhs_solver *)&k;
         int st = odhs_solver_create_by_name(absent[k], &s);
         if (st == ODHS_OK) {

@@ -65,6 +65,27 @@ typedef struct odhs_solver_type {
  *  0 = 10*Nc + 100). Statistics: "iterations". Warm-started from the previous
  *  forces by the stepper. */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cg;
+/** CHOLMOD sparse Cholesky of N = S S^T, factored from S without forming N
+ *  (only in builds with SuiteSparse; otherwise "cholmod" gives
+ *  ODHS_E_NOTINSTALLED). The symbolic analysis is kept while the contact
+ *  list is unchanged; a geometry change refactors numerically only. A
+ *  non-positive pivot or a reciprocal condition estimate (cholmod_rcond)
+ *  below "min_rcond" (default 1e-14) gives ODHS_E_SINGULAR. Parameters:
+ *  "min_rcond", "supernodal" (0 simplicial, 1 supernodal, -1 automatic,
+ *  the default). Statistics: "analyses", "factorizations", "rcond",
+ *  "nnz_L", "flops", "cholmod_status". */
+ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
+/** CHOLMOD factor as a preconditioner for CG ("cholmod-pcg"): a simplicial
+ *  LDL' factor over stable contact slots, updated with CHOLMOD's Modify
+ *  module (cholmod_rowadd / cholmod_rowdel; GPL-2.0-or-later) when contacts
+ *  appear or disappear, and refactored after "refactor_every" geometry
+ *  changes (default 50), when CG needs more than "refactor_iterations"
+ *  (default 40), when the slots run out or the fill doubles. Exact (one
+ *  iteration) while the geometry is unchanged, e.g. during rewiring.
+ *  Parameters: "tol" (default 1e-12), "maxiter", "min_rcond",
+ *  "refactor_every", "refactor_iterations". Statistics: "iterations",
+ *  "updates", "factorizations", "analyses", "rcond", "nnz_L", "capacity". */
+ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
 /** SuiteSparseQR on A = S^T (only in builds with SuiteSparse; otherwise
  *  "spqr" gives ODHS_E_NOTINSTALLED): solve_ls computes the least-squares
  *  forces from Q^T g and R without forming N (the error grows with cond(S^T),
@@ -88,9 +109,9 @@ typedef struct odhs_solver odhs_solver; /* struct tag declared in network.h */
 /** Create a solver handle for a backend type (user or built-in). The table
  *  must outlive the handle. ODHS_E_INVALID for a malformed table. */
 ODHS_API int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out);
-/** Create a built-in solver by name: "cg", "dense". Names of backends not
- *  built into this library ("cholmod", "spqr") give ODHS_E_NOTINSTALLED;
- *  unknown names ODHS_E_INVALID. */
+/** Create a built-in solver by name: "cg", "dense", and with SuiteSparse
+ *  "cholmod", "cholmod-pcg", "spqr". Names of backends not built into this
+ *  library give ODHS_E_NOTINSTALLED; unknown names ODHS_E_INVALID. */
 ODHS_API int odhs_solver_create_by_name(const char *name, odhs_solver **out);
 /** Destroy; NULL is a no-op. */
 ODHS_API void odhs_solver_destroy(odhs_solver *s);

@@ -75,7 +75,8 @@ ODHS_API int odhs_system_volume(const odhs_system *sys, double *vol);
 /**
  * Set the Lees-Edwards strain gamma (any finite value; it is remapped into
  * [-Lx/(2Ly), Lx/(2Ly)] as above). The positions are kept; the images of the
- * lattice change. Errors: ODHS_E_NONFINITE, ODHS_E_OVERLAP (with particles
+ * lattice change. Errors: ODHS_E_NONFINITE, ODHS_E_INVALID (|gamma| beyond
+ * 2^50 Lx/Ly: cannot be remapped exactly), ODHS_E_OVERLAP (with particles
  * set, if the new images overlap).
  */
 ODHS_API int odhs_system_set_strain(odhs_system *sys, double gamma);
@@ -94,8 +95,9 @@ ODHS_API int odhs_system_get_radii(const odhs_system *sys, double *r);
 
 /**
  * Set all positions x[0..n*dim-1] (lab frame; wrapped into the box).
- * Errors: ODHS_E_NONFINITE, ODHS_E_OVERLAP (if radii are set; the message
- * names the pair and the overlap).
+ * Errors: ODHS_E_NONFINITE, ODHS_E_INVALID (a coordinate more than 2^50 box
+ * lengths away: its image cannot be found exactly), ODHS_E_OVERLAP (if radii
+ * are set; the message names the pair and the overlap).
  */
 ODHS_API int odhs_system_set_positions(odhs_system *sys, const double *x);
 /** Copy the (wrapped, lab-frame) positions into x[0..n*dim-1]. */

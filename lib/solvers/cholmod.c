@@ -45,21 +45,26 @@
  *     (cholmod_updown was the alternative: N changes by a row and a column,
  *     which is a rank-2 symmetric change of M; rowadd/rowdel do exactly that
  *     change and keep the factor's dimension, so they are the natural fit.)
- *   - when only contacts changed since the factor was made (e.g. inside the
+ *   - the backend remembers the normal each row of the factor was made with.
+ *     While no normal of a contact in the factor has moved (e.g. inside the
  *     stepper's rewiring, which removes and re-adds contacts at a fixed
  *     geometry) the updated factor is the exact LDL' of N and PCG converges in
- *     one or two iterations. When the normals moved, the factor belongs to an
- *     older geometry and PCG makes up the difference.
- *   - full refactorisation (new analysis, slots renumbered 0..Nc-1) every
- *     "refactor_every" setups (default 50; 0 = only when needed), when the
- *     slot capacity would be exceeded, when many contacts changed at once
- *     (more than (Nc + 64)/8: cheaper than updates), when an update leaves a
- *     D entry not above min_rcond * max(D) (the mixed-geometry matrix need not
- *     stay positive definite, and a new contact can make N singular), and
- *     inside solve when PCG with an aged factor needs more than
- *     "refactor_iterations" (default 40) iterations or breaks down: the solve
- *     then goes on from its current iterate with the fresh factor. A fresh
- *     factor that fails is ODHS_E_SINGULAR, as for "cholmod".
+ *     one iteration. Once normals moved, the factor belongs to an older
+ *     geometry and PCG makes up the difference (about 5 iterations at 1e-12
+ *     after one step of a sheared packing).
+ *   - full refactorisation (slots renumbered 0..Nc-1, new analysis unless
+ *     only the geometry changed since the last one) after "refactor_every"
+ *     geometry changes (setups at which some normal had moved since the
+ *     previous setup; default 50; 0 = never for this reason), when the slot
+ *     capacity would be exceeded, when many contacts changed at once (more
+ *     than (Nc + 64)/8: cheaper than updates), when the updates have doubled
+ *     the fill of L, when an update leaves a D entry not above
+ *     min_rcond * max(D) (a mixed-geometry matrix need not stay positive
+ *     definite, and a new contact can make N singular), and inside solve when
+ *     PCG with an aged factor needs more than "refactor_iterations" (default
+ *     40) iterations or breaks down: the solve then goes on from its current
+ *     iterate with the fresh factor. A fresh factor that fails is
+ *     ODHS_E_SINGULAR, as for "cholmod".
  *   Parameters: "tol" (relative residual, default 1e-12), "maxiter" (default
  *   0 = 10*Nc + 100), "min_rcond" (1e-14), "refactor_every" (50),
  *   "refactor_iterations" (40), "supernodal" (only 0 is accepted: the Modify
@@ -419,9 +424,13 @@ typedef struct {
     double *w;
     size_t wcap;
     int valid;                /* factor and slot map describe the last setup */
-    int fresh;                /* factor made at the current geometry */
-    size_t since;             /* setups since the last full factorisation */
+    double *snrm;             /* cap*dim: normal each slot's row was made with */
+    double *lnrm;             /* cap*dim: normal of each slot at the last setup */
+    size_t snrmcap, lnrmcap;
+    int fresh;                /* the factor is exact for the current N */
+    size_t since;             /* geometry changes since the last full factorisation */
     size_t updates_since_analysis;
+    double nnz0;              /* nnz(L) right after the last full factorisation */
     /* parameters */
     double tol, maxiter, min_rcond, refactor_every, refactor_iterations;
     /* statistics */
@@ -460,6 +469,8 @@ static void pcg_destroy(void *state)
     odhs__free(s->freel);
     odhs__free(s->pinv);
     odhs__free(s->dels);
+    odhs__free(s->snrm);
+    odhs__free(s->lnrm);
     odhs__free(s->c2s);
     odhs__free(s->cnt);
     odhs__free(s->start);
@@ -534,6 +545,9 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
     if ((st = pcg_slot_arrays(s, cap))) return st;
     if ((st = grow((void **)&s->c2s, &s->c2scap, nc, sizeof *s->c2s))) return st;
     if ((st = grow((void **)&s->cnt, &s->cntcap, n + 1, sizeof *s->cnt))) return st;
+    if ((st = grow((void **)&s->snrm, &s->snrmcap, cap * (size_t)net->dim, sizeof *s->snrm)) ||
+        (st = grow((void **)&s->lnrm, &s->lnrmcap, cap * (size_t)net->dim, sizeof *s->lnrm)))
+        return st;
 
     int numeric_only = s->L && s->updates_since_analysis == 0 && s->cap == cap && s->n == n &&
                        s->dim == net->dim;
@@ -566,6 +580,8 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
         }
     }
     for (size_t c = 0; c < nc; ++c) s->c2s[c] = c;
+    memcpy(s->snrm, net->nrm, nc * (size_t)net->dim * sizeof *s->snrm);
+    memcpy(s->lnrm, net->nrm, nc * (size_t)net->dim * sizeof *s->lnrm);
     s->nc = nc;
     int ok = cholmod_factorize(s->A, s->L, &s->c);
     s->status = s->c.status;
@@ -578,6 +594,7 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
     }
     if ((st = check_factor(s->L, &s->c, s->min_rcond, &s->rcond))) return st;
     if (s->L->is_super || s->L->is_ll) return ODHS_E_INTERNAL; /* Modify needs LDL' */
+    s->nnz0 = factor_nnz(s->L, &s->c);
     s->valid = 1;
     s->fresh = 1;
     return ODHS_OK;
@@ -638,6 +655,8 @@ static int pcg_rowadd(pcg_state *s, const odhs_network *net, size_t c, size_t t)
     Rp[0] = 0;
     Rp[1] = (int)nz;
     s->R->sorted = 0;
+    memcpy(s->snrm + t * d, nc_, (size_t)d * sizeof *nc_);
+    memcpy(s->lnrm + t * d, nc_, (size_t)d * sizeof *nc_);
     int ok = cholmod_rowadd((size_t)s->pinv[t], s->R, s->L, &s->c);
     s->status = s->c.status;
     s->updates += 1.0;
@@ -651,18 +670,33 @@ static int pcg_setup(void *state, const odhs_network *net)
     size_t nc = net->nc;
     int st;
     if (!s->valid || !s->L || s->n != net->n || s->dim != net->dim) return pcg_full(s, net);
-    s->since++;
-    s->fresh = 0;
-    if (s->refactor_every > 0 && (double)s->since >= s->refactor_every) return pcg_full(s, net);
     if ((st = grow((void **)&s->c2s, &s->c2scap, nc, sizeof *s->c2s))) return st;
-    /* match slots to contacts by their pair */
+    /* match slots to contacts by their pair; did normals move since the
+     * last setup, and since their rows went into the factor? */
+    int d = net->dim, moved = 0, aged = 0;
+    size_t bytes = (size_t)d * sizeof *net->nrm;
     for (size_t c = 0; c < nc; ++c) s->c2s[c] = NO_SLOT;
     size_t ndel = 0;
     for (size_t t = 0; t < s->cap; ++t) {
         if (s->si[t] == NO_SLOT) continue;
         size_t k = odhs__net_find(net, s->si[t], s->sj[t]);
-        if (k == SIZE_MAX) s->dels[ndel++] = t;
-        else s->c2s[k] = t;
+        if (k == SIZE_MAX) {
+            s->dels[ndel++] = t;
+            continue;
+        }
+        s->c2s[k] = t;
+        const double *nk = net->nrm + k * d;
+        if (memcmp(s->lnrm + t * d, nk, bytes)) {
+            moved = 1;
+            memcpy(s->lnrm + t * d, nk, bytes);
+        }
+        if (!aged && memcmp(s->snrm + t * d, nk, bytes)) aged = 1;
+    }
+    /* an aged factor is a preconditioner only; count the geometry changes */
+    if (aged) s->fresh = 0;
+    if (moved) {
+        s->since++;
+        if (s->refactor_every > 0 && (double)s->since >= s->refactor_every) return pcg_full(s, net);
     }
     size_t nadd = 0;
     for (size_t c = 0; c < nc; ++c) nadd += s->c2s[c] == NO_SLOT;
@@ -698,9 +732,10 @@ static int pcg_setup(void *state, const odhs_network *net)
     if (ndel + nadd) {
         /* an updated factor of a mixed-geometry (or singular) matrix may have
          * lost definiteness: then start afresh (which also decides whether N
-         * itself is singular) */
+         * itself is singular); likewise when the updates doubled the fill */
         double dmin, dmax;
         if (!simplicial_pivots(s->L, &dmin, &dmax) || !(dmin > s->min_rcond * dmax)) return pcg_full(s, net);
+        if (factor_nnz(s->L, &s->c) > 2.0 * s->nnz0 + 1000.0) return pcg_full(s, net);
     }
     s->valid = 1;
     return ODHS_OK;
@@ -801,6 +836,11 @@ static int pcg_solve(void *state, const odhs_network *net, const double *b, doub
         memset(x, 0, nc * sizeof *x);
         return ODHS_OK;
     }
+    for (size_t c = 0; c < nc; ++c) /* an unusable guess: start from zero */
+        if (!isfinite(x[c])) {
+            memset(x, 0, nc * sizeof *x);
+            break;
+        }
     size_t maxit = s->maxiter > 0 ? (size_t)s->maxiter : 10 * nc + 100, it = 0;
     size_t limit = maxit;
     if (!s->fresh && (double)limit > s->refactor_iterations) limit = (size_t)s->refactor_iterations;
@@ -810,7 +850,10 @@ static int pcg_solve(void *state, const odhs_network *net, const double *b, doub
             /* the aged preconditioner is not good enough: refactor at the
              * current geometry and go on from the current iterate */
             for (size_t c = 0; c < nc; ++c)
-                if (!isfinite(x[c])) x[c] = 0.0;
+                if (!isfinite(x[c])) {
+                    memset(x, 0, nc * sizeof *x);
+                    break;
+                }
             int fs = pcg_full(s, net);
             if (fs) {
                 s->iterations = (double)it;
