@@ -46,4 +46,17 @@ static inline int cli_scene(int dim, unsigned long n, unsigned long seed, double
     return odhs_system_place_random(*out, phi0, seed + 1);
 }
 
+/* The solver the examples use close to jamming: CHOLMOD as a preconditioner
+ * for CG when the library has it, else dense Cholesky for small systems and
+ * CG for large ones (CG alone stalls close to jamming). */
+static inline const char *cli_default_solver(size_t n)
+{
+    odhs_solver *s;
+    if (odhs_solver_create_by_name("cholmod-pcg", &s) == ODHS_OK) {
+        odhs_solver_destroy(s);
+        return "cholmod-pcg";
+    }
+    return n <= 2000 ? "dense" : "cg";
+}
+
 #endif /* ODHS_EXAMPLES_CLI_H */

@@ -25,8 +25,10 @@ static void usage(FILE *f)
             "  --series FILE.csv  write phi,pressure,z,events per output interval\n"
             "  --every X          output interval in packing fraction (default 0.01)\n"
             "  --dt X             step in units of 1/rate (default 1e-3)\n"
-            "  --solver NAME      linear solver: cg, dense (default: dense up to N = 2000,\n"
-            "                     cg above; CG stalls close to jamming)\n"
+            "  --solver NAME      linear solver: cg, dense, cholmod, cholmod-pcg, spqr\n"
+            "                     (default cholmod-pcg when built with SuiteSparse, else\n"
+            "                     dense up to N = 2000 and cg above; CG alone stalls\n"
+            "                     close to jamming)\n"
             "  --n N              built-in scene: number of particles (default 256)\n"
             "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
             "  --seed S           built-in scene: random seed (default 1)\n"
@@ -96,7 +98,7 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    if (!solver_name) solver_name = odhs_system_count(sys) <= 2000 ? "dense" : "cg";
+    if (!solver_name) solver_name = cli_default_solver(odhs_system_count(sys));
     odhs_solver *solver;
     rc = odhs_solver_create_by_name(solver_name, &solver);
     if (rc) {

@@ -28,7 +28,8 @@ static void usage(FILE *f)
             "  --n N              built-in scene: number of particles (default 256)\n"
             "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
             "  --seed S           built-in scene: random seed (default 1)\n"
-            "  --solver NAME      linear solver (default dense up to N = 2000, else cg)\n"
+            "  --solver NAME      linear solver (default cholmod-pcg when built with\n"
+            "                     SuiteSparse, else dense up to N = 2000 and cg above)\n"
             "  --dt X             step in natural units (default 1e-3)\n"
             "  --max-strain X     shear protocols: give up after this strain (default 20)\n"
             "  --help             this message\n"
@@ -117,7 +118,7 @@ int main(int argc, char **argv)
         return 1;
     }
     n = odhs_system_count(sys);
-    if (!solver_name) solver_name = n <= 2000 ? "dense" : "cg";
+    if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
     if ((rc = odhs_solver_create_by_name(solver_name, &solver))) {
         fprintf(stderr, "jam_packing: solver %s: %s\n", solver_name, odhs_strerror(rc));
