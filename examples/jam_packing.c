@@ -32,6 +32,8 @@ static void usage(FILE *f)
             "                     SuiteSparse, else dense up to N = 2000 and cg above)\n"
             "  --dt X             step in natural units (default 1e-3)\n"
             "  --max-strain X     shear protocols: give up after this strain (default 20)\n"
+            "  --correction K     drift correction every K steps (default 1: certified\n"
+            "                     packings need contact gaps at round-off when they jam)\n"
             "  --help             this message\n"
             "Protocols: compress = isotropic compression; shear = compress to jamming,\n"
             "dilate by 0.2%% and shear at fixed volume until arrest; shear+compress =\n"
@@ -65,6 +67,7 @@ int main(int argc, char **argv)
     const char *protocol = "compress", *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL,
                *solver_name = NULL;
     double dt = 1e-3, max_strain = 20.0;
+    unsigned long corr = 1;
     unsigned long n = 256, seed = 1, dim = 2;
     for (int a = 1; a < argc; ++a) {
         const char *o = argv[a];
@@ -90,6 +93,7 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--solver")) solver_name = v;
         else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
         else if (!strcmp(o, "--max-strain")) bad = cli_double(v, &max_strain) || max_strain <= 0;
+        else if (!strcmp(o, "--correction")) bad = cli_ulong(v, &corr) || corr > 1000000;
         else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
         else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
         else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
@@ -126,7 +130,8 @@ int main(int argc, char **argv)
     }
     odhs_driver *drv;
     odhs_stepper *st;
-    if (odhs_driver_create(&drv) || odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt)) {
+    if (odhs_driver_create(&drv) || odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt) ||
+        odhs_stepper_set_correction_interval(st, (unsigned)corr)) {
         fprintf(stderr, "jam_packing: setup failed\n");
         return 1;
     }
@@ -147,7 +152,9 @@ int main(int argc, char **argv)
             odhs_system_scale_box(sys, pow(1.002, 1.0 / odhs_system_dim(sys)));
             odhs_driver_set_compression_rate(drv, 0.0);
             odhs_driver_set_shear_rate(drv, 1.0);
-            if (odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt)) return 1;
+            if (odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt) ||
+                odhs_stepper_set_correction_interval(st, (unsigned)corr))
+                return 1;
             fprintf(stderr, "jam_packing: compression jammed at phi = %.6f; shearing at phi = %.6f\n", phi,
                     phi / 1.002);
             rc = drive(st, drv, 1, 0, max_strain);

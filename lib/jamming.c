@@ -143,7 +143,23 @@ int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, 
         /* try the most recently added contacts first: removing the contact
          * that made the subset isostatic leaves a full-rank network */
         st = ODHS_E_SINGULAR;
-        for (size_t t = 0; t < 6 && t < m && st; ++t) st = null_sparse(net, solver, idx, m, m - 1 - t, y);
+        for (size_t t = 0; t < 24 && t < m && st; ++t) {
+            st = null_sparse(net, solver, idx, m, m - 1 - t, y);
+            if (st) continue;
+            /* if f0 vanishes on the fixed contact, the rest is still singular
+             * and the solve is not unique: accept only a true null vector */
+            memset(full, 0, net->nc * sizeof *full);
+            double mean = 0.0;
+            for (size_t a = 0; a < m; ++a) {
+                full[idx[a]] = y[a];
+                mean += fabs(y[a]) / (double)m;
+            }
+            odhs__net_ST(net, full, F);
+            double rmax = 0.0;
+            for (size_t k = 0; k < net->n * (size_t)net->dim; ++k) rmax = fmax(rmax, fabs(F[k]));
+            if (!(rmax <= 1e-8 * mean)) st = ODHS_E_SINGULAR;
+        }
+        memset(full, 0, net->nc * sizeof *full);
     }
     if (st) {
         st = odhs__neterr(net, st, "self-stress f0: %s", odhs_strerror(st));
