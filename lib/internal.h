@@ -29,6 +29,25 @@ void odhs__free(void *p);
 /* malloc of n*size with overflow check */
 void *odhs__malloc_array(size_t n, size_t size);
 
+#ifdef ODHS_FAULT_INJECTION
+/* Allocation-failure injection, compiled in only with -DODHS_FAULT_INJECTION
+ * (the `make check-allocfail` build; never in normal builds). Per thread:
+ * every odhs__malloc/calloc/realloc (and so malloc_array) counts as one
+ * allocation. odhs__fault_arm(n, sticky) resets the count and makes the
+ * n-th allocation from now on return NULL (n = 0: count only), and with
+ * sticky != 0 every later one too;
+ * odhs__fault_disarm() stops failing (counting goes on);
+ * odhs__fault_count() is the number of allocations since the last arm;
+ * odhs__fault_fired() whether the armed failure has happened;
+ * odhs__fault_live() the number of blocks this thread allocated through
+ * odhs__* and has not freed yet (a cheap leak check between two points). */
+void odhs__fault_arm(uint64_t n, int sticky);
+void odhs__fault_disarm(void);
+uint64_t odhs__fault_count(void);
+int odhs__fault_fired(void);
+int64_t odhs__fault_live(void);
+#endif
+
 /* ---- error messages ---------------------------------------------------- */
 /* Format into buf (ODHS_ERRMSG_LEN) and return status. */
 int odhs__err(char *buf, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
@@ -65,7 +84,11 @@ int odhs__syserr(const odhs_system *sys, int status, const char *fmt, ...) ODHS_
 static inline double odhs__remap_strain(double gamma, const double *L)
 {
     double u = L[0] / L[1];
-    return gamma - nearbyint(gamma / u) * u;
+    double g = gamma - nearbyint(gamma / u) * u;
+    /* rounding can leave |g| a hair above u/2 */
+    if (g > 0.5 * u) g -= u;
+    else if (g < -0.5 * u) g += u;
+    return g;
 }
 
 /* Wrap one position (dim entries) into the primary lab rectangle, given box
@@ -136,6 +159,7 @@ struct odhs_solver {
     double check_tol;
     int refine;        /* iterative refinement steps for direct backends */
     double last_residual;
+    double last_backward; /* normwise backward error of the last solve */
     double nsolves;
     double *work;    /* residual check */
     size_t work_cap;

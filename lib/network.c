@@ -71,8 +71,13 @@ static int grow(odhs_network *net)
     double *f = odhs__realloc(net->f, cap * sizeof *f);
     if (f) net->f = f;
     if (!ci || !cj || !kind || !nrm || !dist || !gap || !f) return ODHS_E_NOMEM;
+    /* the capacity counts only once the hash table fits it too: a full
+     * table would make every lookup probe forever */
+    if (net->hcap < 2 * cap) {
+        int st = hash_resize(net, 4 * cap);
+        if (st) return st;
+    }
     net->cap = cap;
-    if (net->hcap < 2 * cap) return hash_resize(net, 4 * cap);
     return ODHS_OK;
 }
 
@@ -475,9 +480,15 @@ int odhs_network_detect(odhs_network *net, const odhs_system *sys, double tol)
     if (st) return st;
     if (!isfinite(tol) || tol < 0.0) return odhs__neterr(net, ODHS_E_INVALID, "tolerance must be >= 0");
     detect_ctx c = {net, sys->r, tol, ODHS_OK};
+    size_t nc0 = net->nc;
     st = odhs__pairs(sys->dim, sys->n, sys->x, sys->r, sys->rmax, sys->L, sys->gamma,
                      tol * 2.0 * sys->rmax, detect_cb, &c);
-    if (st == ODHS_E_NOMEM || c.status) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    if (st == ODHS_E_NOMEM || c.status) {
+        /* leave the network as it was: drop the contacts added so far (they
+         * are the last ones; removing the newest first restores everything) */
+        while (net->nc > nc0) odhs__net_remove_at(net, net->nc - 1);
+        return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    }
     odhs__net_geometry(net, sys);
     return ODHS_OK;
 }

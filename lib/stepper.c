@@ -278,7 +278,8 @@ static int rewire(odhs_stepper *st)
             if ((s = odhs__jam_polish(st->sys, net, st->sol, net->f)))
                 return sterr(st, s, "polishing the jammed packing: %s", odhs_strerror(s));
             if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
-                return sterr(st, ODHS_POTENTIALLY_JAMMED, "jammed packing: %s", net->errmsg);
+                return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "jammed packing: %s",
+                             net->errmsg);
             double fr = 0.0, vol;
             for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
             odhs_system_volume(st->sys, &vol);
@@ -681,23 +682,32 @@ int odhs_stepper_reset(odhs_stepper *st)
     st->lambda = 0.0;
     for (size_t i = 0; i < st->n; ++i) st->lambda += 2.0 * st->sys->r[i];
     st->lambda /= (double)st->n;
-    /* keep permanent contacts, rebuild the temporary ones */
+    /* keep permanent contacts, rebuild the temporary ones; an error puts
+     * the configuration and the network back as they were (rollback) */
     odhs_network *net = st->net;
+    if ((s = snapshot(st))) return s;
     odhs__net_geometry(net, st->sys);
     for (size_t c = net->nc; c-- > 0;) {
         double sig = st->sys->r[net->ci[c]] + st->sys->r[net->cj[c]];
         if (net->kind[c] == ODHS_CONTACT_TEMPORARY && fabs(net->gap[c]) > fmax(1e-6, st->contact_tol) * sig)
             odhs__net_remove_at(net, c);
     }
-    if ((s = odhs_network_detect(net, st->sys, st->contact_tol))) return sterr(st, s, "%s", net->errmsg);
-    if ((s = build_neighbours(st))) return s;
-    if ((s = eval_forces(st))) return s;
+    if ((s = odhs_network_detect(net, st->sys, st->contact_tol))) {
+        s = sterr(st, s, "%s", net->errmsg);
+        goto fail;
+    }
+    if ((s = build_neighbours(st))) goto fail;
+    if ((s = eval_forces(st))) goto fail;
     st->nchg = 0;
-    if ((s = rewire(st))) return s;
+    if ((s = rewire(st))) goto fail;
     st->nchg = 0;
     st->drv_version = st->drv->version;
     st->ready = 1;
     return ODHS_OK;
+fail:
+    if (s < 0) rollback(st);
+    st->nchg = 0;
+    return s;
 }
 
 /* ---- drift correction (Sect. IV C) ------------------------------------- */
@@ -888,6 +898,9 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     if (!st->ready && (s = odhs_stepper_reset(st))) return s;
     if (st->jammed) return sterr(st, ODHS_JAMMED, "the packing is jammed: no further steps under this driving");
     if ((s = snapshot(st))) return s;
+    /* step bookkeeping that rollback() does not cover */
+    const uint64_t drv_version0 = st->drv_version, nrejected0 = st->nrejected;
+    const double tau0 = st->tau, h0 = st->h;
     st->nchg = 0;
     if (st->drv_version != st->drv->version) {
         /* the driver changed since the forces were solved: re-solve now */
@@ -934,6 +947,15 @@ again:;
     size_t ci, cj;
     double t = predict(st, G, vel, tplan, EPS_V * velocity_scale(st), &ci, &cj);
     advance(st, G, vel, t);
+    for (size_t k = 0; k < st->nd; ++k)
+        if (!isfinite(st->sys->x[k])) {
+            s = sterr(st, ODHS_E_NONFINITE, "non-finite positions after a step of %g (rates too large?)", t);
+            goto fail;
+        }
+    if (!isfinite(st->sys->L[0]) || !(st->sys->L[0] > 0.0) || !isfinite(st->sys->gamma)) {
+        s = sterr(st, ODHS_E_NONFINITE, "the box became degenerate after a step of %g", t);
+        goto fail;
+    }
     st->time += t;
     st->strain += t * st->drv->gdot;
     st->nsteps++;
@@ -992,6 +1014,13 @@ again:;
     return ODHS_OK;
 fail:
     rollback(st);
+    /* the forces are again those of the start of the step: solved for the
+     * driver as it was then (a changed driver is re-solved next time) */
+    st->drv_version = drv_version0;
+    st->tau = tau0;
+    st->h = h0;
+    st->nrejected = nrejected0;
+    st->jammed = 0;
     st->nchg = 0;
     return s;
 }
@@ -1017,6 +1046,7 @@ int odhs_stepper_correct(odhs_stepper *st)
     int s, stop = 0, added = 0;
     if (!st->ready && (s = odhs_stepper_reset(st))) return s;
     if ((s = snapshot(st))) return s;
+    const int jammed0 = st->jammed;
     st->nchg = 0;
     if ((s = correct(st, &added))) goto fail;
     if ((s = rewire(st))) goto fail;
@@ -1025,6 +1055,7 @@ int odhs_stepper_correct(odhs_stepper *st)
     return stop ? ODHS_STOPPED : ODHS_OK;
 fail:
     rollback(st);
+    st->jammed = jammed0;
     st->nchg = 0;
     return s;
 }

@@ -166,12 +166,12 @@ static int commit(odhs_system *sys, const double *L, double gamma, double *r, in
     int st;
     double rmax = 0.0;
     if (!isfinite(gamma)) return odhs__syserr(sys, ODHS_E_NONFINITE, "strain is not finite");
-    if (fabs(gamma) > 0x1p50 * (L[0] / L[1]))
-        return odhs__syserr(sys, ODHS_E_INVALID, "strain %g is too large to remap exactly", gamma);
-    gamma = odhs__remap_strain(gamma, L);
     if (has_r && (st = check_radii(sys, r, &rmax))) return st;
     /* the box must hold two largest diameters once particles are placed */
     if ((st = check_box(sys, L, (has_r && has_x) ? rmax : 0.0))) return st;
+    if (fabs(gamma) > 0x1p50 * (L[0] / L[1]))
+        return odhs__syserr(sys, ODHS_E_INVALID, "strain %g is too large to remap exactly", gamma);
+    gamma = odhs__remap_strain(gamma, L);
     if (has_x) {
         if ((st = check_positions(sys, L, x))) return st;
         for (size_t i = 0; i < sys->n; ++i) odhs__wrap(sys->dim, L, gamma, x + i * sys->dim);

@@ -40,10 +40,70 @@ const char *odhs_strerror(int status)
 }
 
 /* ---- allocation --------------------------------------------------------- */
-void *odhs__malloc(size_t size) { return malloc(size ? size : 1); }
-void *odhs__calloc(size_t n, size_t size) { return calloc(n ? n : 1, size ? size : 1); }
-void *odhs__realloc(void *p, size_t size) { return realloc(p, size ? size : 1); }
-void odhs__free(void *p) { free(p); }
+#ifdef ODHS_FAULT_INJECTION
+/* Test builds only (see internal.h): a per-thread allocation counter, a
+ * "fail the n-th allocation (and, if sticky, every later one)" trigger and a
+ * count of live blocks. Thread-local, so handles used in different threads
+ * stay independent even in this build; normal builds have none of it. */
+static _Thread_local uint64_t fault_count;  /* allocations since the last arm */
+static _Thread_local uint64_t fault_target; /* 0 = count only */
+static _Thread_local int fault_sticky;      /* fail every allocation from the target on */
+static _Thread_local int fault_fired;
+static _Thread_local int64_t fault_live;    /* allocated and not yet freed */
+
+void odhs__fault_arm(uint64_t n, int sticky)
+{
+    fault_count = 0;
+    fault_target = n;
+    fault_sticky = sticky;
+    fault_fired = 0;
+}
+
+void odhs__fault_disarm(void) { fault_target = 0; }
+uint64_t odhs__fault_count(void) { return fault_count; }
+int odhs__fault_fired(void) { return fault_fired; }
+int64_t odhs__fault_live(void) { return fault_live; }
+
+/* count one allocation attempt; 1 if it is to fail */
+static int fault_hit(void)
+{
+    ++fault_count;
+    if (!fault_target || fault_count < fault_target || (fault_count > fault_target && !fault_sticky)) return 0;
+    fault_fired = 1;
+    return 1;
+}
+/* count a new block (q != NULL that did not replace p) */
+static void *fault_live_add(void *q, const void *p)
+{
+    if (q && !p) fault_live++;
+    return q;
+}
+#define ODHS_FAULT_HIT() fault_hit()
+#define ODHS_FAULT_LIVE(q, p) fault_live_add((q), (p))
+#define ODHS_FAULT_FREE(p) (fault_live -= (p) != NULL)
+#else
+#define ODHS_FAULT_HIT() 0
+#define ODHS_FAULT_LIVE(q, p) (q)
+#define ODHS_FAULT_FREE(p) ((void)0)
+#endif
+
+void *odhs__malloc(size_t size)
+{
+    return ODHS_FAULT_HIT() ? NULL : ODHS_FAULT_LIVE(malloc(size ? size : 1), NULL);
+}
+void *odhs__calloc(size_t n, size_t size)
+{
+    return ODHS_FAULT_HIT() ? NULL : ODHS_FAULT_LIVE(calloc(n ? n : 1, size ? size : 1), NULL);
+}
+void *odhs__realloc(void *p, size_t size)
+{
+    return ODHS_FAULT_HIT() ? NULL : ODHS_FAULT_LIVE(realloc(p, size ? size : 1), p);
+}
+void odhs__free(void *p)
+{
+    ODHS_FAULT_FREE(p);
+    free(p);
+}
 void *odhs__malloc_array(size_t n, size_t size)
 {
     if (size && n > SIZE_MAX / size) return NULL;
