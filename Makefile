@@ -4,6 +4,15 @@
 #   all (default)   lib/libodhs.a, lib/libodhs.so.X.Y.Z + soname/dev symlinks
 #   check           build and run the Check test runner, plus check-symbols
 #   check-asan      rebuild library + tests in build-asan/ with ASan/UBSan, run
+#   check-allocfail rebuild in build-allocfail/ with allocation-failure
+#                   injection (-DODHS_FAULT_INJECTION) + ASan/UBSan/LSan and
+#                   run the allocfail suite (fail every allocation in turn)
+#   check-tsan      rebuild library + tests in build-tsan/ with ThreadSanitizer,
+#                   run the threads suite (must report no data race)
+#   fuzz            build every tests/fuzz/fuzz_*.c with libFuzzer (clang)
+#                   against the library rebuilt in build-fuzz/
+#   fuzz-ci         run each fuzzer FUZZ_TIME (60) s on a copy of its corpus,
+#                   fail on any crash; prints the number of executions
 #   check-symbols   fail if lib/libodhs.so exports anything not named odhs_*
 #   check-run       run the tests without deps-if-missing/check-symbols
 #   tests           only build the runner build/tests/run_tests
@@ -15,7 +24,8 @@
 #   bench           build bench/*.c against lib/libodhs.a into build/bench/
 #   install, uninstall   honour PREFIX, DESTDIR, LIBDIR, INCLUDEDIR
 #   deps, deps-if-missing   install the Debian build dependencies (apt-get)
-#   clean           remove build/, build-asan/, lib/*.a, lib/*.so*
+#   clean           remove build/, build-asan/, build-allocfail/, build-tsan/,
+#                   build-fuzz/, lib/*.a, lib/*.so*
 #
 # Knobs (set on the command line, e.g. `make SUITESPARSE=0 check`):
 #   SUITESPARSE=auto|1|0   CHOLMOD/SPQR backends (auto: if cholmod.h exists)
@@ -115,9 +125,11 @@ LIBS_PRIVATE := $(strip $(ODHS_LIBS))
 OPTFLAGS  ?= -O2 -g
 WARNFLAGS ?= -Wall -Wextra -Wpedantic -Werror
 SANFLAGS  ?=
+# Set only by check-allocfail (-DODHS_FAULT_INJECTION): a test-only build.
+FAULTFLAGS ?=
 DEPFLAGS  := -MMD -MP
 
-ODHS_CPPFLAGS := -Iinclude -Ilib $(SUITESPARSE_CPPFLAGS) -DODHS_HAVE_LAPACKE=1
+ODHS_CPPFLAGS := -Iinclude -Ilib $(SUITESPARSE_CPPFLAGS) -DODHS_HAVE_LAPACKE=1 $(FAULTFLAGS)
 ODHS_CFLAGS   := -std=c11 $(OPTFLAGS) $(WARNFLAGS) $(SANFLAGS) -fPIC -fvisibility=hidden
 
 LIB_COMPILE = $(CC) $(ODHS_CPPFLAGS) $(CPPFLAGS) $(ODHS_CFLAGS) $(CFLAGS) $(DEPFLAGS)
@@ -170,6 +182,14 @@ ASAN_BUILD    := build-asan
 ASAN_SANFLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 ASAN_TEST_ENV := CK_FORK=no CK_DEFAULT_TIMEOUT=600 OPENBLAS_NUM_THREADS=1 \
                  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
+
+# Allocation-failure injection (check-allocfail): own tree, sanitizers with
+# LeakSanitizer, only the allocfail suite, no fork (LSan and the per-case
+# leak checks need the test in this process).
+ALLOCFAIL_BUILD    := build-allocfail
+ALLOCFAIL_TEST_ENV := CK_RUN_SUITE=allocfail CK_FORK=no CK_DEFAULT_TIMEOUT=600 \
+                      OPENBLAS_NUM_THREADS=1 ASAN_OPTIONS=detect_leaks=1 \
+                      UBSAN_OPTIONS=print_stacktrace=1
 
 # ---------------------------------------------------------------------------
 # Examples, pkg-config consumer, benchmarks
@@ -261,7 +281,7 @@ $(SHARED_DEVLINK): $(SHARED_SONAME)
 # ===========================================================================
 # Tests
 # ===========================================================================
-.PHONY: check check-run check-asan check-symbols check-readme tests
+.PHONY: check check-run check-asan check-allocfail check-symbols check-readme tests
 
 # deps-if-missing runs first, then a fresh make instance does the work, so
 # that SUITESPARSE=auto and the pkg-config lookups see freshly installed
@@ -282,6 +302,14 @@ check-asan: deps-if-missing
 	    BUILD=$(ASAN_BUILD) OUT_LIBDIR=$(ASAN_BUILD)/lib \
 	    OPTFLAGS="-O1 -g" SANFLAGS="$(ASAN_SANFLAGS)" \
 	    TEST_ENV="$(ASAN_TEST_ENV)"
+
+# Every allocation of representative runs made to fail in turn (see
+# tests/check_allocfail.c); separate tree, sanitizers and leak checks on.
+check-allocfail: deps-if-missing
+	@$(MAKE) --no-print-directory check-run \
+	    BUILD=$(ALLOCFAIL_BUILD) OUT_LIBDIR=$(ALLOCFAIL_BUILD)/lib \
+	    OPTFLAGS="-O1 -g" SANFLAGS="$(ASAN_SANFLAGS)" FAULTFLAGS=-DODHS_FAULT_INJECTION \
+	    TEST_ENV="$(ALLOCFAIL_TEST_ENV)"
 
 # The README's C example must be examples/minimal.c (built by `make examples`),
 # so the example users copy is one that compiles and runs.
@@ -320,7 +348,7 @@ $(OBJDIR)/$(TEST_RUNNER_MAIN:.c=.o): $(SUITES_INC)
 $(TEST_RUNNER): $(TEST_OBJS) $(STATIC_LIB) $(TEST_OBJS_STAMP)
 	@mkdir -p $(@D)
 	$(CC) $(ODHS_CFLAGS) $(CFLAGS) $(LDFLAGS) -o $@ $(TEST_OBJS) $(STATIC_LIB) \
-	    $(ODHS_LIBS) $(CHECK_LIBS) $(LDLIBS)
+	    $(ODHS_LIBS) $(CHECK_LIBS) -pthread $(LDLIBS)
 
 # ===========================================================================
 # Install / uninstall
@@ -433,11 +461,99 @@ build/bench/%: bench/%.c $(STATIC_LIB) $(FLAGS_STAMP)
 	    $(LDFLAGS) -o $@ $< $(STATIC_LIB) $(ODHS_LIBS) $(LDLIBS)
 
 # ===========================================================================
+# Reliability: ThreadSanitizer run of the threads suite, libFuzzer targets
+# ===========================================================================
+.PHONY: check-tsan fuzz fuzz-ci
+
+# check-tsan: library + tests in build-tsan/ with -fsanitize=thread, only the
+# threads suite, no fork. OpenBLAS is kept single-threaded (its own pool is
+# not instrumented); halt_on_error makes the first race report fail the run.
+TSAN_BUILD    := build-tsan
+TSAN_SANFLAGS := -fsanitize=thread -fno-omit-frame-pointer
+TSAN_TEST_ENV := CK_RUN_SUITE=threads CK_FORK=no CK_DEFAULT_TIMEOUT=600 OPENBLAS_NUM_THREADS=1 \
+                 TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:history_size=4
+
+check-tsan: deps-if-missing
+	@$(MAKE) --no-print-directory check-run \
+	    BUILD=$(TSAN_BUILD) OUT_LIBDIR=$(TSAN_BUILD)/lib \
+	    OPTFLAGS="-O1 -g" SANFLAGS="$(TSAN_SANFLAGS)" \
+	    TEST_ENV="$(TSAN_TEST_ENV)"
+
+# Fuzzing with libFuzzer. Every tests/fuzz/fuzz_<name>.c is a target (new
+# files are picked up), with seed corpus tests/fuzz/corpus_<name>/ and an
+# optional dictionary tests/fuzz/fuzz_<name>.dict. The library sources are
+# compiled again with the fuzzer's own flags into build-fuzz/ (never the gcc
+# objects of build/). fuzz-ci runs each target FUZZ_TIME seconds on a copy of
+# its corpus (the seeds stay untouched) and fails on any crash, leak,
+# sanitizer report or input slower than FUZZ_UNIT_TIMEOUT seconds; crashing
+# inputs are kept in build-fuzz/ci/<name>/artifacts/.
+FUZZ_CC           ?= clang
+FUZZ_BUILD        := build-fuzz
+FUZZ_SANFLAGS     := -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+                     -fno-omit-frame-pointer
+FUZZ_CFLAGS       := -std=c11 -Wall -Wextra $(FUZZ_SANFLAGS)
+FUZZ_TIME         ?= 60
+FUZZ_UNIT_TIMEOUT ?= 25
+FUZZ_ENV          := OPENBLAS_NUM_THREADS=1 ASAN_OPTIONS=detect_leaks=1 \
+                     UBSAN_OPTIONS=print_stacktrace=1
+FUZZ_SRCS         := $(sort $(wildcard tests/fuzz/fuzz_*.c))
+FUZZ_NAMES        := $(FUZZ_SRCS:tests/fuzz/fuzz_%.c=%)
+FUZZ_BINS         := $(FUZZ_SRCS:tests/fuzz/%.c=$(FUZZ_BUILD)/%)
+FUZZ_LIB_OBJS     := $(LIB_SRCS:%.c=$(FUZZ_BUILD)/obj/%.o)
+FUZZ_LIB          := $(FUZZ_BUILD)/libodhs-fuzz.a
+FUZZ_STAMP        := $(FUZZ_BUILD)/compile-flags.txt
+
+# keep the fuzz targets' objects (intermediate files otherwise)
+.SECONDARY: $(FUZZ_SRCS:%.c=$(FUZZ_BUILD)/obj/%.o)
+
+fuzz: $(FUZZ_BINS)
+	@echo "fuzz: $(if $(FUZZ_BINS),built $(FUZZ_BINS),no tests/fuzz/fuzz_*.c)"
+
+$(FUZZ_STAMP): FORCE
+	$(call write_if_changed,$@,'$(FUZZ_CC) $(ODHS_CPPFLAGS) $(FUZZ_CFLAGS) | $(ODHS_LIBS)' $(FUZZ_LIB_OBJS))
+
+$(FUZZ_BUILD)/obj/%.o: %.c $(FUZZ_STAMP)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(ODHS_CPPFLAGS) $(CPPFLAGS) $(FUZZ_CFLAGS) $(DEPFLAGS) -c -o $@ $<
+
+$(FUZZ_LIB): $(FUZZ_LIB_OBJS) $(FUZZ_STAMP)
+	@rm -f $@
+	$(AR) rcs $@ $(FUZZ_LIB_OBJS)
+
+$(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/tests/fuzz/fuzz_%.o $(FUZZ_LIB)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -o $@ $< $(FUZZ_LIB) $(ODHS_LIBS)
+
+fuzz-ci: fuzz
+	@status=0; \
+	for name in $(FUZZ_NAMES); do \
+	    run=$(FUZZ_BUILD)/ci/$$name; \
+	    rm -rf $$run; mkdir -p $$run/corpus $$run/artifacts; \
+	    if [ -d tests/fuzz/corpus_$$name ]; then cp -R tests/fuzz/corpus_$$name/. $$run/corpus/; fi; \
+	    dict=; if [ -f tests/fuzz/fuzz_$$name.dict ]; then dict=-dict=tests/fuzz/fuzz_$$name.dict; fi; \
+	    echo "== fuzz_$$name: $(FUZZ_TIME) s on a copy of tests/fuzz/corpus_$$name ($$(ls $$run/corpus | wc -l) seeds)"; \
+	    if env $(FUZZ_ENV) $(FUZZ_BUILD)/fuzz_$$name $$dict -max_total_time=$(FUZZ_TIME) \
+	        -timeout=$(FUZZ_UNIT_TIMEOUT) -rss_limit_mb=2048 -print_final_stats=1 \
+	        -artifact_prefix=$$run/artifacts/ $$run/corpus > $$run/log.txt 2>&1; \
+	    then result=ok; else result=FAILED; status=1; fi; \
+	    execs=$$(sed -n 's/^stat::number_of_executed_units: *//p' $$run/log.txt | tail -n 1); \
+	    echo "fuzz_$$name: $$result: $${execs:-?} executions, corpus $$(ls $$run/corpus | wc -l) inputs (log: $$run/log.txt)"; \
+	    if [ $$result = FAILED ]; then \
+	        tail -n 80 $$run/log.txt; echo "fuzz_$$name: reproducers:"; ls -l $$run/artifacts; \
+	    fi; \
+	done; \
+	if [ $$status -ne 0 ]; then echo "fuzz-ci: FAILED"; else echo "fuzz-ci: ok ($(words $(FUZZ_NAMES)) targets)"; fi; \
+	exit $$status
+
+-include $(FUZZ_LIB_OBJS:.o=.d) $(FUZZ_BUILD)/obj/tests/fuzz/*.d
+
+# ===========================================================================
 # Dependencies (Debian/Ubuntu)
 # ===========================================================================
 .PHONY: deps deps-if-missing
+# clang and libclang-rt-14-dev (libFuzzer, sanitizer runtimes): make fuzz.
 DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
-                 check pkg-config gcc make
+                 check pkg-config gcc make \
+                 clang libclang-rt-14-dev
 
 deps:
 	@if [ "$$(id -u)" -eq 0 ]; then SUDO=; else SUDO=sudo; fi; \
@@ -466,7 +582,8 @@ deps-if-missing:
 .PHONY: clean help
 
 clean:
-	rm -rf build build-asan
+	rm -rf build build-asan $(ALLOCFAIL_BUILD)
+	rm -rf $(TSAN_BUILD) $(FUZZ_BUILD)
 	rm -f lib/*.a lib/*.so lib/*.so.*
 
 # Prints the comment block at the top of this file.
