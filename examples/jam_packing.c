@@ -39,7 +39,9 @@ static void usage(FILE *f)
             "dilate by 0.2%% and shear at fixed volume until arrest; shear+compress =\n"
             "shear with compression at 1/5 of the shear rate; pressure = shear at fixed\n"
             "pressure, doubled every 0.05 strain (towards zero strain rate).\n"
-            "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed.\n");
+            "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed\n"
+            "or not certified (force balance < 1e-12, gaps < 1e-13, no overlap, all\n"
+            "backbone forces > 0, isostatic).\n");
 }
 
 /* drive with the given driver until jammed (or failure / strain budget) */
@@ -198,6 +200,13 @@ int main(int argc, char **argv)
         printf("worst contact gap      %.3e (relative to the contact distance)\n", c.gap_error);
         printf("worst overlap          %.3e\n", c.overlap);
         printf("smallest force         %.3e (relative to the mean force)\n", c.min_force);
+        int certified = c.jammed && c.isostatic && c.force_balance < 1e-12 && c.gap_error < 1e-13 &&
+                        c.overlap <= 1e-14 && c.min_force > 0.0;
+        printf("certified              %s\n", certified ? "yes" : "no");
+        if (status == 0 && !certified) {
+            fprintf(stderr, "jam_packing: jammed, but the certificate fails (see above)\n");
+            status = 3;
+        }
     }
     const odhs_network *net = odhs_stepper_network(st);
     if (outpath && odhs_xyz_write(sys, outpath)) {
