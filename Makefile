@@ -486,7 +486,8 @@ check-tsan: deps-if-missing
 # objects of build/). fuzz-ci runs each target FUZZ_TIME seconds on a copy of
 # its corpus (the seeds stay untouched) and fails on any crash, leak,
 # sanitizer report or input slower than FUZZ_UNIT_TIMEOUT seconds; crashing
-# inputs are kept in build-fuzz/ci/<name>/artifacts/.
+# inputs are kept in build-fuzz/ci/<name>/artifacts/ and the targets' own
+# temporary files go to build-fuzz/ci/<name>/tmp/ (TMPDIR).
 FUZZ_CC           ?= clang
 FUZZ_BUILD        := build-fuzz
 FUZZ_SANFLAGS     := -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
@@ -527,11 +528,11 @@ fuzz-ci: fuzz
 	@status=0; \
 	for name in $(FUZZ_NAMES); do \
 	    run=$(FUZZ_BUILD)/ci/$$name; \
-	    rm -rf $$run; mkdir -p $$run/corpus $$run/artifacts; \
+	    rm -rf $$run; mkdir -p $$run/corpus $$run/artifacts $$run/tmp; \
 	    if [ -d tests/fuzz/corpus_$$name ]; then cp -R tests/fuzz/corpus_$$name/. $$run/corpus/; fi; \
 	    dict=; if [ -f tests/fuzz/fuzz_$$name.dict ]; then dict=-dict=tests/fuzz/fuzz_$$name.dict; fi; \
 	    echo "== fuzz_$$name: $(FUZZ_TIME) s on a copy of tests/fuzz/corpus_$$name ($$(ls $$run/corpus | wc -l) seeds)"; \
-	    if env $(FUZZ_ENV) $(FUZZ_BUILD)/fuzz_$$name $$dict -max_total_time=$(FUZZ_TIME) \
+	    if env $(FUZZ_ENV) TMPDIR=$$run/tmp $(FUZZ_BUILD)/fuzz_$$name $$dict -max_total_time=$(FUZZ_TIME) \
 	        -timeout=$(FUZZ_UNIT_TIMEOUT) -rss_limit_mb=2048 -print_final_stats=1 \
 	        -artifact_prefix=$$run/artifacts/ $$run/corpus > $$run/log.txt 2>&1; \
 	    then result=ok; else result=FAILED; status=1; fi; \

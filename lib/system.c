@@ -105,6 +105,14 @@ static int overlap_cb(size_t i, size_t j, const double *rij, double gap, void *v
 
 static int check_box(const odhs_system *sys, const double *L, double rmax)
 {
+    {
+        /* the Lees-Edwards remapping works with Lx/Ly: it must be representable */
+        double u = L[0] / L[1];
+        if (isfinite(L[0]) && isfinite(L[1]) && L[0] > 0.0 && L[1] > 0.0 &&
+            !(u > 0.0 && isfinite(u) && u > 1e-100 && u < 1e100))
+            return odhs__syserr(sys, ODHS_E_INVALID, "box aspect ratio Lx/Ly = %g is out of range [1e-100, 1e100]",
+                                u);
+    }
     for (int k = 0; k < sys->dim; ++k) {
         if (!isfinite(L[k])) return odhs__syserr(sys, ODHS_E_NONFINITE, "box edge %d is not finite", k);
         if (!(L[k] > 0.0))

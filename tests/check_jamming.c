@@ -16,10 +16,13 @@
  *  - "rattlers": the constrained subset is found by iterated removal (a
  *    chain that becomes rattlers one particle at a time), in 2D and 3D.
  *  - "packings": packings produced by the stepper driven as
- *    examples/jam_packing.c does (compress, shear+compress, pressure in 2D;
- *    compress in 3D) pass the certificate, and the certificate is checked
- *    against an independent recomputation (brute-force overlaps over lattice
- *    images, own rattler removal, own force balance, own SVD of S^T).
+ *    examples/jam_packing.c does (compress and shear+compress in 2D, compress
+ *    in 3D) pass the certificate, and the certificate is checked against an
+ *    independent recomputation (brute-force overlaps over lattice images, own
+ *    rattler removal, own force balance, own SVD of S^T).
+ *  - "known_failures" (only with ODHS_JAMMING_KNOWN_FAILURES set): the same
+ *    for the shear+compress and fixed-pressure cases that this version fails
+ *    (see docs/jamming.md, "Known problems").
  *  - "large": on a network with more than 600 backbone contacts the solver
  *    route of odhs_network_null_vector equals the LAPACK route to 1e-10.
  *  - "io": odhs_contacts_write round trip, odhs_svg_write well-formedness, and
@@ -929,24 +932,45 @@ static const struct {
     uint64_t seed;
     const char *protocol;
 } pack_cases[] = {
-    /* The shear+compress and fixed-pressure protocols do not yet pass the
-     * certificate (seed 3 shear+compress: a 1e-3 overlap after polishing;
-     * fixed pressure: the rewiring cycles). They are known failures recorded
-     * in the Jammed-packings issue and are left out until fixed:
-     * {2, 64, 1..3, "shear+compress"}, {2, 64, 1..3, "pressure"}. */
-    {2, 64, 1, "compress"}, {2, 64, 2, "compress"}, {2, 64, 3, "compress"}, {2, 128, 1, "compress"},
-    {3, 48, 1, "compress"}, {3, 64, 1, "compress"}, {3, 64, 2, "compress"},
+    /* Driven as jam_packing drives them (correction every step, cholmod-pcg
+     * when available). The shear+compress and fixed-pressure cases that do not
+     * yet pass the certificate (shear+compress seed 2: min_force < 0 after
+     * polishing, seed 3: a 1e-3 overlap; fixed pressure: the rewiring cycles)
+     * are known failures recorded in the Jammed-packings issue; they are in
+     * known_failure_cases below and left out of the default run until fixed. */
+    {2, 64, 1, "compress"},       {2, 64, 2, "compress"}, {2, 64, 3, "compress"}, {2, 128, 1, "compress"},
+    {2, 64, 1, "shear+compress"}, {2, 128, 1, "shear+compress"},
+    {3, 48, 1, "compress"},       {3, 64, 1, "compress"}, {3, 64, 2, "compress"},
 };
 #define N_PACK_CASES ((int)(sizeof pack_cases / sizeof pack_cases[0]))
 
+/* The cases left out above, run only when ODHS_JAMMING_KNOWN_FAILURES is set
+ * in the environment (test case "known_failures"), to check fixes. With this
+ * version they fail: shear+compress seed 2 (min_force < 0 after polishing),
+ * seed 3 (overlap 1.1e-3), seed 4 and all fixed-pressure cases (rewiring
+ * cycle, ODHS_E_REWIRE); pressure at N = 128 with cholmod-pcg writes past a
+ * CHOLMOD buffer (heap-buffer-overflow in pcg_precond, lib/solvers/cholmod.c;
+ * a crash, so it is the last case). */
+static const struct {
+    int dim;
+    size_t n;
+    uint64_t seed;
+    const char *protocol;
+} known_failure_cases[] = {
+    {2, 64, 2, "shear+compress"}, {2, 64, 3, "shear+compress"}, {2, 64, 4, "shear+compress"},
+    {2, 64, 1, "pressure"},       {2, 64, 2, "pressure"},       {2, 64, 3, "pressure"},
+    {2, 128, 1, "pressure"},
+};
+#define N_KNOWN_FAILURES ((int)(sizeof known_failure_cases / sizeof known_failure_cases[0]))
+
 /* One packing: the run must end with ODHS_JAMMED, the certificate must pass,
  * and the independent recomputation must agree. */
-START_TEST(test_packing_certified)
+static void packing_certified(int dim, size_t n, uint64_t seed, const char *protocol)
 {
     /* failures are collected and asserted after everything is freed, so that
      * the sanitizer run (CK_FORK=no) reports only the failure, not leaks */
     jrun r;
-    jrun_start(&r, pack_cases[_i].dim, pack_cases[_i].n, pack_cases[_i].seed, pack_cases[_i].protocol, "default");
+    jrun_start(&r, dim, n, seed, protocol, "default");
     jrun_drive(&r);
     char head[160], cmsg[512], imsg[768], fail[2048] = "";
     snprintf(head, sizeof head, "%dD N = %zu seed %llu %s", r.dim, r.n, (unsigned long long)r.seed, r.protocol);
@@ -985,6 +1009,18 @@ START_TEST(test_packing_certified)
     jrun_free(&r);
     ck_assert_msg(fail[0] == '\0', "%s", fail);
 }
+
+START_TEST(test_packing_certified)
+{
+    packing_certified(pack_cases[_i].dim, pack_cases[_i].n, pack_cases[_i].seed, pack_cases[_i].protocol);
+}
+END_TEST
+
+START_TEST(test_packing_known_failure)
+{
+    packing_certified(known_failure_cases[_i].dim, known_failure_cases[_i].n, known_failure_cases[_i].seed,
+                      known_failure_cases[_i].protocol);
+}
 END_TEST
 
 /* ========================================================================== */
@@ -1004,10 +1040,15 @@ END_TEST
  * (Running the stepper to jamming at N ~ 400 with the dense solver takes
  * minutes, which is why the tiling is used here.)
  */
-/* solver routes vs the exact (replicated) f0 */
-/* measured agreement is ~1e-9: the replicated geometry differs at round-off
- * and the backbone of the tiled packing is ill-conditioned (sigma_2 ~ 0.03) */
-#define LARGE_TOL 1e-8
+/* Tolerances against the exact (replicated) f0. Measured on this network
+ * (sigma_2 of S^T = 1.1e-3, sigma_max = 2.3): dense solver route 1.7e-11 and
+ * 2.4e-11, cg route 5.4e-11 and 8.5e-11 (limited by its 1e-12 residual
+ * tolerance), LAPACK route 9.8e-10 and 4.6e-10. The LAPACK route takes the
+ * eigenvector of N = S S^T, whose accuracy is eps lambda_max / lambda_2 =
+ * eps (sigma_max / sigma_2)^2 ~ 1e-9 here; its tolerance is that bound
+ * (x10), computed from an independent SVD. */
+#define LARGE_TOL_DIRECT 1e-10
+#define LARGE_TOL_ITER 1e-9
 
 typedef struct {
     size_t n; /* particles per copy */
@@ -1190,7 +1231,7 @@ START_TEST(test_null_vector_large)
         ck_assert_msg(rc == ODHS_OK, "LAPACK route: %d (%s)", rc, odhs_network_errmsg(net));
         /* the LAPACK route (eigenvector of N) is accurate to about
          * eps lambda_max / lambda_2 = eps (sigma_max / sigma_2)^2 */
-        double tol_lap = fmax(LARGE_TOL, 10.0 * DBL_EPSILON * (smax / snext) * (smax / snext));
+        double tol_lap = fmax(LARGE_TOL_DIRECT, 10.0 * DBL_EPSILON * (smax / snext) * (smax / snext));
         double e_lap = 0.0;
         for (size_t k = 0; k < m; ++k) e_lap = fmax(e_lap, fabs(fl[k] - fe[k]));
         if (!(e_lap < tol_lap)) {
@@ -1212,18 +1253,19 @@ START_TEST(test_null_vector_large)
                 ex = fmax(ex, fabs(fs[k] - fe[k]));
             }
             size_t fl_len = strlen(fails);
+            double tol_s = s == 0 ? LARGE_TOL_DIRECT : LARGE_TOL_ITER;
             if (getenv("ODHS_TEST_VERBOSE"))
                 fprintf(stderr, "large: bonds %s, %s: status %d, |f0 - LAPACK| %.3e, |f0 - exact| %.3e, LAPACK-exact %.3e\n",
                         order == 0 ? "first" : "last", names[s], rc, e, ex, e_lap);
             if (order == 0 || s == 0) {
                 /* the contact fixed to 1 carries f0 != 0: must work, to
                  * 1e-10 of the exact f0, and agree with the LAPACK route */
-                if (rc != ODHS_OK || !(ex < LARGE_TOL) || !(e < tol_lap + LARGE_TOL))
+                if (rc != ODHS_OK || !(ex < tol_s) || !(e < tol_lap + tol_s))
                     snprintf(fails + fl_len, sizeof fails - fl_len,
                              "bonds %s, solver %s: status %d (%s), |f0_solver - f0_exact| = %.3e, "
                              "|f0_solver - f0_LAPACK| = %.3e (residual %.3e); ",
                              order == 0 ? "first" : "last", names[s], rc, odhs_strerror(rc), ex, e, res);
-            } else if (rc == ODHS_OK && !(ex < LARGE_TOL)) {
+            } else if (rc == ODHS_OK && !(ex < tol_s)) {
                 /* the newest contacts (the bonds) carry f0 = 0: fixing one
                  * of them to 1 has no solution; the call must fail or try
                  * another contact, never return a wrong f0 */
@@ -1525,5 +1567,11 @@ Suite *make_jamming_suite(void)
     tcase_set_timeout(tc, 600);
     tcase_add_loop_test(tc, test_packing_certified, 0, N_PACK_CASES);
     suite_add_tcase(s, tc);
+    if (getenv("ODHS_JAMMING_KNOWN_FAILURES")) {
+        tc = tcase_create("known_failures");
+        tcase_set_timeout(tc, 600);
+        tcase_add_loop_test(tc, test_packing_known_failure, 0, N_KNOWN_FAILURES);
+        suite_add_tcase(s, tc);
+    }
     return s;
 }

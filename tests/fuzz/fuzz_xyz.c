@@ -26,9 +26,10 @@
 
 #include "odhs.h"
 
-/* ---- a private directory for this process, removed at exit ------------- */
-static char fz_dir[64];
-static char fz_path[128];
+/* ---- a private directory for this process under $TMPDIR (or /tmp), removed
+ * at a normal exit; the file in it is removed after every input ----------- */
+static char fz_dir[320];
+static char fz_path[400];
 
 static void fz_cleanup(void)
 {
@@ -41,7 +42,7 @@ static const char *fz_file(void)
 {
     if (!fz_dir[0]) {
         const char *base = getenv("TMPDIR");
-        if (!base || !*base || strlen(base) > 40) base = "/tmp";
+        if (!base || !*base || strlen(base) > 256) base = "/tmp";
         snprintf(fz_dir, sizeof fz_dir, "%s/odhs-fuzz-xyz-XXXXXX", base);
         if (!mkdtemp(fz_dir)) {
             perror("fuzz_xyz: mkdtemp");
