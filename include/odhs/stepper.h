@@ -133,7 +133,12 @@ ODHS_API int odhs_stepper_run_events(odhs_stepper *st, uint64_t count);
  *  driving; the last step is truncated to land on phi). */
 ODHS_API int odhs_stepper_run_until_packing_fraction(odhs_stepper *st, double phi);
 
-/* ---- observables (of the current state) -------------------------------- */
+/* ---- observables (of the current state) --------------------------------
+ * Observables that need forces or velocities (stress, shear stress,
+ * pressure, dissipation, power, velocities) return ODHS_E_STATE until the
+ * stepper has a valid state (after odhs_stepper_reset or the first step);
+ * counters, time, strain, kappa, coordination and errors are available at
+ * once (zero before the first step). */
 ODHS_API int odhs_stepper_time(const odhs_stepper *st, double *t);
 ODHS_API int odhs_stepper_strain(const odhs_stepper *st, double *gamma);
 /** Adaptive-integrator counters: rejected steps and the current step (in tau

@@ -100,7 +100,10 @@ ODHS_API int odhs_system_get_radii(const odhs_system *sys, double *r);
  * are set; the message names the pair and the overlap).
  */
 ODHS_API int odhs_system_set_positions(odhs_system *sys, const double *x);
-/** Copy the (wrapped, lab-frame) positions into x[0..n*dim-1]. */
+/** Copy the (wrapped, lab-frame) positions into x[0..n*dim-1].
+ *  ODHS_E_STATE if positions were never set. Functions that need both radii
+ *  and positions (separation, validate, for_each_pair, packing_fraction needs
+ *  radii) return ODHS_E_STATE before they are set. */
 ODHS_API int odhs_system_get_positions(const odhs_system *sys, double *x);
 
 /**
