@@ -27,9 +27,10 @@
  *
  * Tables:
  *  1. phi_J over 20 seeds, 2D and 3D (mean, standard deviation, min, max,
- *     rattler fraction); the system size is N = 1024 (2D) and 1000 (3D) when
- *     the CHOLMOD backend is available, else smaller sizes that fit the
- *     budget (printed, with what was skipped).
+ *     rattler fraction): the largest of N = 1024, 512, 256, 128, 64 (2D) and
+ *     1000, 500, 250, 128, 64 (3D) whose estimated cost fits 35% of the
+ *     budget each (estimated from a pilot run as t ~ N^3 with a sparse solver,
+ *     N^4 with dense); the sizes skipped are printed.
  *  2. time to a certified packing for N = 256, 512, 1024, 4096 (2D) and 1000 (3D),
  *     each size run only if its estimated time fits the remaining budget.
  *  3. soft-sphere comparison: not available (no soft-core module yet).

@@ -744,6 +744,12 @@ static int pcg_setup(void *state, const odhs_network *net)
 /* z = M^{-1} r through the slots */
 static int pcg_precond(pcg_state *s, size_t nc, const double *r, double *z)
 {
+    /* a refactorisation inside the solve may have grown the slot capacity */
+    if (!s->B || s->B->nrow != s->cap) {
+        cholmod_free_dense(&s->B, &s->c);
+        s->B = cholmod_allocate_dense(s->cap, 1, s->cap, CHOLMOD_REAL, &s->c);
+        if (!s->B) return cm_error(&s->c);
+    }
     double *bx = s->B->x;
     memset(bx, 0, s->cap * sizeof *bx);
     for (size_t c = 0; c < nc; ++c) bx[s->c2s[c]] = r[c];
