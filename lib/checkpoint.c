@@ -142,6 +142,19 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
         put_u64(&b, (uint64_t)net->kind[c]);
         put_f64(&b, net->f[c]);
     }
+    /* optional: composites (rest lengths of the bonds, rigid-body labels) */
+    if (net->nperm || net->rbody) {
+        put_tag(&b, "CMP ");
+        put_u64(&b, net->nperm);
+        for (size_t c = 0; c < net->nc; ++c)
+            if (net->kind[c] == ODHS_CONTACT_PERMANENT) {
+                put_u64(&b, c);
+                put_f64(&b, net->rest[c]);
+            }
+        put_u64(&b, net->rbody ? 1u : 0u);
+        if (net->rbody)
+            for (size_t i = 0; i < n; ++i) put_u64(&b, net->rbody[i] == SIZE_MAX ? UINT64_MAX : net->rbody[i]);
+    }
     put_tag(&b, "END ");
     put_u64(&b, b.nomem ? 0 : fnv1a(b.p, b.len));
     if (b.nomem) {
@@ -237,6 +250,12 @@ static int tag(rbuf *b, const char *t)
         return -1;
     }
     return 0;
+}
+
+/* whether the next section is t (nothing consumed) */
+static int peek_tag(const rbuf *b, const char *t)
+{
+    return !b->bad && b->len - b->pos >= 4 && !memcmp(b->p + b->pos, t, 4);
 }
 
 static int finite_all(const double *v, size_t n)
@@ -407,6 +426,32 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         size_t k = odhs__net_add(st->net, (size_t)i, (size_t)j, (int)kind);
         if (k == SIZE_MAX) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
         st->net->f[k] = f;
+    }
+    if (peek_tag(&b, "CMP ")) {
+        odhs_network *net = st->net;
+        tag(&b, "CMP ");
+        uint64_t np = get_u64(&b);
+        if (b.bad || np != net->nperm) FAIL(ODHS_E_FORMAT, "checkpoint: bad bond count");
+        for (uint64_t q = 0; q < np; ++q) {
+            uint64_t c = get_u64(&b);
+            double rest = get_f64(&b);
+            if (b.bad || c >= net->nc || net->kind[c] != ODHS_CONTACT_PERMANENT || !(rest > 0.0) ||
+                !isfinite(rest))
+                FAIL(ODHS_E_FORMAT, "checkpoint: bad bond %llu", (unsigned long long)q);
+            net->rest[c] = rest;
+        }
+        uint64_t has_rb = get_u64(&b);
+        if (b.bad || has_rb > 1) FAIL(ODHS_E_FORMAT, "checkpoint: bad rigid-body flag");
+        if (has_rb) {
+            if (n > (b.len - b.pos) / 8) FAIL(ODHS_E_FORMAT, "checkpoint: truncated rigid-body labels");
+            net->rbody = odhs__malloc_array(n, sizeof *net->rbody);
+            if (!net->rbody) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
+            for (size_t i = 0; i < n; ++i) {
+                uint64_t l = get_u64(&b);
+                if (l != UINT64_MAX && l >= n) FAIL(ODHS_E_FORMAT, "checkpoint: bad rigid-body label");
+                net->rbody[i] = l == UINT64_MAX ? SIZE_MAX : (size_t)l;
+            }
+        }
     }
     if (b.pos != b.len) FAIL(ODHS_E_FORMAT, "checkpoint: unexpected trailing data");
     odhs__net_geometry(st->net, sys);

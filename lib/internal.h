@@ -130,8 +130,34 @@ struct odhs_network {
     size_t nbar, ncon;     /* core size, contacts inside the core */
     size_t *work;          /* scratch: queue (n) */
     unsigned char *mark;   /* scratch flags (n) */
+    /* composites (Sect. V C); untouched by scenes without permanent contacts */
+    double *rest;          /* cap: rest length of each permanent contact (NAN: a_i + a_j) */
+    size_t nperm;          /* number of permanent contacts */
+    size_t *rbody;         /* NULL, or n rigid-body labels (SIZE_MAX: not in a rigid body) */
+    /* constrained subset on bodies (connected components of the permanent
+     * contacts), recomputed on demand when nperm > 0; cached by version */
+    uint64_t topo;         /* bumped when contacts are added, removed or change kind */
+    uint64_t work_composite; /* passes of composite-only code (odhs_stepper_feature_work) */
+    int bc_valid;
+    uint64_t bc_topo;
+    unsigned char *bcore;  /* n flags */
+    size_t bnbar, bncon;
     char errmsg[ODHS_ERRMSG_LEN];
 };
+
+/* target distance of contact c: a_i + a_j, or a permanent contact's rest length */
+static inline double odhs__net_sigma(const odhs_network *net, const odhs_system *sys, size_t c)
+{
+    if (net->nperm && net->kind[c] == ODHS_CONTACT_PERMANENT && !isnan(net->rest[c])) return net->rest[c];
+    return sys->r[net->ci[c]] + sys->r[net->cj[c]];
+}
+/* whether particles i and j belong to the same rigid body */
+static inline int odhs__same_body(const odhs_network *net, size_t i, size_t j)
+{
+    return net->rbody && net->rbody[i] != SIZE_MAX && net->rbody[i] == net->rbody[j];
+}
+/* body-aware constrained subset (only when nperm > 0): fills bcore, bnbar, bncon */
+int odhs__net_body_core(const odhs_network *net);
 
 odhs_network *odhs__net_new(int dim, size_t n);
 int odhs__neterr(const odhs_network *net, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
@@ -216,6 +242,7 @@ struct odhs_stepper {
     double *disps;    /* adaptive: displacement record at the start (nd) */
     double Ms[9];
     uint64_t nrejected, nsolves_pred;
+    uint64_t work_pressure; /* pressure-control solves (odhs_stepper_feature_work) */
     unsigned corr_every;
     double contact_tol;
     odhs_event_fn evfn;
@@ -254,6 +281,7 @@ struct odhs_stepper {
     size_t *sci, *scj;
     int *skind;
     double *sf;
+    double *srest;    /* rest lengths (copied only with permanent contacts) */
     size_t snc, scap;
     /* events of the last step */
     odhs_event *ev;

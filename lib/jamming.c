@@ -228,7 +228,7 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
         odhs__net_geometry(net, sys);
         double gmax = 0.0, fg = 0.0, fr = 0.0;
         for (size_t c = 0; c < nc; ++c) {
-            gmax = fmax(gmax, fabs(net->gap[c]) / (sys->r[net->ci[c]] + sys->r[net->cj[c]]));
+            gmax = fmax(gmax, fabs(net->gap[c]) / odhs__net_sigma(net, sys, c));
             fg += f0[c] * net->gap[c];
             fr += f0[c] * net->dist[c];
         }
@@ -276,7 +276,7 @@ static int cert_ov_cb(size_t i, size_t j, const double *rij, double gap, void *v
 {
     (void)rij;
     cert_ov_ctx *c = vctx;
-    if (odhs__net_find(c->net, i, j) != SIZE_MAX) return 0;
+    if (odhs__net_find(c->net, i, j) != SIZE_MAX || odhs__same_body(c->net, i, j)) return 0;
     double rel = -gap / (c->r[i] + c->r[j]);
     if (rel > c->worst) c->worst = rel;
     return 0;
@@ -325,10 +325,11 @@ int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert)
     odhs_system_volume(sys, &vol);
     for (size_t k = 0; k < net->nc; ++k) {
         fr += net->f[k] * net->dist[k];
-        c.gap_error = fmax(c.gap_error, fabs(net->gap[k]) / (sys->r[net->ci[k]] + sys->r[net->cj[k]]));
+        c.gap_error = fmax(c.gap_error, fabs(net->gap[k]) / odhs__net_sigma(net, sys, k));
         if (in[net->ci[k]] && in[net->cj[k]]) {
             fsum += net->f[k];
-            fmin = fmin < net->f[k] ? fmin : net->f[k];
+            /* bonds may carry any sign: the smallest force is over contacts */
+            if (net->kind[k] == ODHS_CONTACT_TEMPORARY) fmin = fmin < net->f[k] ? fmin : net->f[k];
         }
     }
     c.pressure = fr / (vol * d);

@@ -70,7 +70,9 @@ static int grow(odhs_network *net)
     if (gap) net->gap = gap;
     double *f = odhs__realloc(net->f, cap * sizeof *f);
     if (f) net->f = f;
-    if (!ci || !cj || !kind || !nrm || !dist || !gap || !f) return ODHS_E_NOMEM;
+    double *rest = odhs__realloc(net->rest, cap * sizeof *rest);
+    if (rest) net->rest = rest;
+    if (!ci || !cj || !kind || !nrm || !dist || !gap || !f || !rest) return ODHS_E_NOMEM;
     /* the capacity counts only once the hash table fits it too: a full
      * table would make every lookup probe forever */
     if (net->hcap < 2 * cap) {
@@ -121,6 +123,9 @@ void odhs_network_destroy(odhs_network *net)
     odhs__free(net->dist);
     odhs__free(net->gap);
     odhs__free(net->f);
+    odhs__free(net->rest);
+    odhs__free(net->rbody);
+    odhs__free(net->bcore);
     odhs__free(net->hkey);
     odhs__free(net->hval);
     if (net->adj)
@@ -314,6 +319,8 @@ size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
     net->kind[c] = kind;
     for (int k = 0; k < net->dim; ++k) net->nrm[c * net->dim + k] = 0.0;
     net->dist[c] = net->gap[c] = net->f[c] = 0.0;
+    net->rest[c] = NAN;
+    if (kind == ODHS_CONTACT_PERMANENT) net->nperm++;
     uint64_t key = pair_key(net, i, j);
     size_t mask = net->hcap - 1, s = hash_slot(key, mask);
     while (net->hkey[s]) s = (s + 1) & mask;
@@ -323,6 +330,7 @@ size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
     net->adj[j][net->adjn[j]++] = i;
     core_edge_added(net, i, j);
     net->version++;
+    net->topo++;
     return c;
 }
 
@@ -360,6 +368,7 @@ void odhs__net_remove_at(odhs_network *net, size_t k)
     adj_remove(net, net->ci[k], net->cj[k]);
     adj_remove(net, net->cj[k], net->ci[k]);
     core_edge_removed(net, net->ci[k], net->cj[k]);
+    if (net->kind[k] == ODHS_CONTACT_PERMANENT) net->nperm--;
     size_t last = net->nc - 1;
     if (k != last) {
         int d = net->dim;
@@ -370,10 +379,12 @@ void odhs__net_remove_at(odhs_network *net, size_t k)
         net->dist[k] = net->dist[last];
         net->gap[k] = net->gap[last];
         net->f[k] = net->f[last];
+        net->rest[k] = net->rest[last];
         hash_set(net, pair_key(net, net->ci[k], net->cj[k]), k);
     }
     net->nc--;
     net->version++;
+    net->topo++;
 }
 
 int odhs_network_add(odhs_network *net, size_t i, size_t j, int kind)
@@ -421,6 +432,7 @@ int odhs_network_find(const odhs_network *net, size_t i, size_t j, size_t *index
 void odhs__net_geometry(odhs_network *net, const odhs_system *sys)
 {
     int d = net->dim;
+    if (net->nperm) net->work_composite++; /* rest lengths of bonds */
     for (size_t c = 0; c < net->nc; ++c) {
         size_t i = net->ci[c], j = net->cj[c];
         double v[3] = {0, 0, 0};
@@ -428,7 +440,7 @@ void odhs__net_geometry(odhs_network *net, const odhs_system *sys)
         odhs__min_image(d, sys->L, sys->gamma, v, NULL);
         double r = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         net->dist[c] = r;
-        net->gap[c] = r - (sys->r[i] + sys->r[j]);
+        net->gap[c] = r - odhs__net_sigma(net, sys, c);
         for (int k = 0; k < d; ++k) net->nrm[c * d + k] = v[k] / r;
     }
     net->version++;
@@ -464,7 +476,8 @@ static int detect_cb(size_t i, size_t j, const double *rij, double gap, void *vc
 {
     (void)rij;
     detect_ctx *c = vctx;
-    if (gap <= c->tol * (c->r[i] + c->r[j]) && odhs__net_find(c->net, i, j) == SIZE_MAX) {
+    if (gap <= c->tol * (c->r[i] + c->r[j]) && !odhs__same_body(c->net, i, j) &&
+        odhs__net_find(c->net, i, j) == SIZE_MAX) {
         if (odhs__net_add(c->net, i, j, ODHS_CONTACT_TEMPORARY) == SIZE_MAX) {
             c->status = ODHS_E_NOMEM;
             return 1;
@@ -629,14 +642,130 @@ int odhs_network_coordination(const odhs_network *net, double *z)
     return ODHS_OK;
 }
 
+/* ---- the constrained subset with composite bodies -------------------------
+ * With permanent contacts the unit of the (d+1)-core is a body: a connected
+ * component of the permanent-contact graph (a single particle otherwise). A
+ * body of k beads held by p permanent (and q internal temporary) contacts has
+ * dof = d k - p - q degrees of freedom (at least those of a rigid body: d for a
+ * single particle, 3 in 2D and 5 (dimer) or 6 in 3D otherwise) and needs dof + 1
+ * contacts with other constrained bodies; a particle is the case k = 1, dof =
+ * d. Removal is iterated to a fixed point as for particles. Counts in integers.
+ * Recomputed from scratch (O(N + Nc)) when the network changed: only scenes
+ * with permanent contacts pay for it. */
+static size_t uf_find(size_t *parent, size_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+int odhs__net_body_core(const odhs_network *cnet)
+{
+    odhs_network *net = (odhs_network *)cnet; /* cache only */
+    if (net->bc_valid && net->bc_topo == net->topo) return ODHS_OK;
+    net->work_composite++;
+    size_t n = net->n, d = (size_t)net->dim;
+    if (!net->bcore && !(net->bcore = odhs__malloc_array(n ? n : 1, 1))) return ODHS_E_NOMEM;
+    /* parent, bid, start (n+1), beads, kb, dof, cnt, queue */
+    size_t *mem = odhs__malloc_array(8 * n + 2, sizeof *mem);
+    unsigned char *in = odhs__malloc_array(n ? n : 1, 1);
+    if (!mem || !in) {
+        odhs__free(mem);
+        odhs__free(in);
+        return ODHS_E_NOMEM;
+    }
+    size_t *parent = mem, *bid = mem + n, *start = mem + 2 * n, *beads = mem + 3 * n + 1;
+    size_t *kb = mem + 4 * n + 1, *dof = mem + 5 * n + 1, *cnt = mem + 6 * n + 1, *q = mem + 7 * n + 1;
+    for (size_t i = 0; i < n; ++i) parent[i] = i;
+    for (size_t c = 0; c < net->nc; ++c)
+        if (net->kind[c] == ODHS_CONTACT_PERMANENT) {
+            size_t a = uf_find(parent, net->ci[c]), b = uf_find(parent, net->cj[c]);
+            if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+        }
+    size_t nb = 0;
+    for (size_t i = 0; i < n; ++i) {
+        size_t r = uf_find(parent, i);
+        bid[i] = r == i ? nb++ : bid[r]; /* roots are the smallest index of their body */
+    }
+    for (size_t b = 0; b <= nb; ++b) start[b] = 0;
+    for (size_t b = 0; b < nb; ++b) kb[b] = dof[b] = cnt[b] = 0;
+    for (size_t i = 0; i < n; ++i) start[bid[i] + 1]++;
+    for (size_t b = 0; b < nb; ++b) start[b + 1] += start[b];
+    for (size_t i = 0; i < n; ++i) beads[start[bid[i]] + kb[bid[i]]++] = i;
+    /* constraints inside each body (permanent + internal temporary) and
+     * contacts to other bodies */
+    size_t *inner = q; /* reused as the queue afterwards */
+    for (size_t b = 0; b < nb; ++b) inner[b] = 0;
+    for (size_t c = 0; c < net->nc; ++c) {
+        size_t a = bid[net->ci[c]], b = bid[net->cj[c]];
+        if (a == b) inner[a]++;
+        else {
+            cnt[a]++;
+            cnt[b]++;
+        }
+    }
+    for (size_t b = 0; b < nb; ++b) {
+        size_t k = kb[b], lo = k == 1 ? d : (d == 2 ? 3 : (k == 2 ? 5 : 6));
+        size_t f = d * k > inner[b] ? d * k - inner[b] : 0;
+        dof[b] = f > lo ? f : lo;
+    }
+    size_t qt = 0, qh = 0;
+    for (size_t b = 0; b < nb; ++b) {
+        in[b] = 1;
+        if (cnt[b] < dof[b] + 1) {
+            in[b] = 2; /* queued */
+            q[qt++] = b;
+        }
+    }
+    while (qh < qt) {
+        size_t b = q[qh++];
+        in[b] = 0;
+        for (size_t p = start[b]; p < start[b + 1]; ++p) {
+            size_t x = beads[p];
+            for (uint32_t k = 0; k < net->adjn[x]; ++k) {
+                size_t o = bid[net->adj[x][k]];
+                if (o == b || in[o] != 1) continue;
+                if (--cnt[o] < dof[o] + 1) {
+                    in[o] = 2;
+                    q[qt++] = o;
+                }
+            }
+        }
+    }
+    size_t nbar = 0, ncon = 0;
+    for (size_t i = 0; i < n; ++i) {
+        net->bcore[i] = in[bid[i]] == 1;
+        nbar += net->bcore[i];
+    }
+    for (size_t c = 0; c < net->nc; ++c) ncon += net->bcore[net->ci[c]] && net->bcore[net->cj[c]];
+    net->bnbar = nbar;
+    net->bncon = ncon;
+    net->bc_valid = 1;
+    net->bc_topo = net->topo;
+    odhs__free(mem);
+    odhs__free(in);
+    return ODHS_OK;
+}
+
 int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon,
                              unsigned char *in_subset, long *zbar_num)
 {
     if (!net) return ODHS_E_NULL;
-    if (nbar) *nbar = net->nbar;
-    if (ncon) *ncon = net->ncon;
-    if (zbar_num) *zbar_num = net->nbar ? 2L * (net->dim - 1) + 2L * (long)net->ncon : 0;
-    if (in_subset) memcpy(in_subset, net->core, net->n);
+    size_t nb = net->nbar, nk = net->ncon;
+    const unsigned char *core = net->core;
+    if (net->nperm) {
+        int st = odhs__net_body_core(net);
+        if (st) return odhs__neterr(net, st, "out of memory");
+        nb = net->bnbar;
+        nk = net->bncon;
+        core = net->bcore;
+    }
+    if (nbar) *nbar = nb;
+    if (ncon) *ncon = nk;
+    if (zbar_num) *zbar_num = nb ? 2L * (net->dim - 1) + 2L * (long)nk : 0;
+    if (in_subset) memcpy(in_subset, core, net->n);
     return ODHS_OK;
 }
 
@@ -656,6 +785,48 @@ int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
 {
     if (!net) return ODHS_E_NULL;
     if (!flag) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
-    *flag = net->nbar > 0 && net->ncon >= (size_t)net->dim * (net->nbar - 1) + 1;
+    size_t nb = net->nbar, nk = net->ncon;
+    if (net->nperm) {
+        int st = odhs_network_constrained(net, &nb, &nk, NULL, NULL);
+        if (st) return st;
+    }
+    *flag = nb > 0 && nk >= (size_t)net->dim * (nb - 1) + 1;
+    return ODHS_OK;
+}
+
+/* ---- permanent contacts with a rest length ---------------------------------- */
+int odhs_network_add_bond(odhs_network *net, size_t i, size_t j, double rest)
+{
+    if (!net) return ODHS_E_NULL;
+    if (i >= net->n || j >= net->n)
+        return odhs__neterr(net, ODHS_E_RANGE, "particle index out of range (N = %zu)", net->n);
+    if (i == j) return odhs__neterr(net, ODHS_E_INVALID, "a bond needs two different particles");
+    if (isnan(rest) || isinf(rest)) return odhs__neterr(net, ODHS_E_NONFINITE, "rest length is not finite");
+    if (!(rest > 0.0)) return odhs__neterr(net, ODHS_E_INVALID, "rest length %g must be > 0", rest);
+    size_t k = odhs__net_find(net, i, j);
+    if (k != SIZE_MAX && net->kind[k] == ODHS_CONTACT_PERMANENT)
+        return odhs__neterr(net, ODHS_E_INVALID, "particles %zu and %zu are already bonded", i, j);
+    if (k == SIZE_MAX && (k = odhs__net_add(net, i, j, ODHS_CONTACT_PERMANENT)) == SIZE_MAX)
+        return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    if (net->kind[k] != ODHS_CONTACT_PERMANENT) {
+        /* a temporary contact becomes a bond: same constraint, new kind */
+        net->kind[k] = ODHS_CONTACT_PERMANENT;
+        net->nperm++;
+        net->topo++;
+    }
+    net->rest[k] = rest;
+    net->gap[k] = net->dist[k] > 0.0 ? net->dist[k] - rest : 0.0;
+    net->version++;
+    return ODHS_OK;
+}
+
+int odhs_network_get_rest_length(const odhs_network *net, const odhs_system *sys, size_t k, double *rest)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!rest) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    int st = check_sys(net, sys);
+    if (st) return st;
+    if (k >= net->nc) return odhs__neterr(net, ODHS_E_RANGE, "contact index %zu >= Nc = %zu", k, net->nc);
+    *rest = odhs__net_sigma(net, sys, k);
     return ODHS_OK;
 }

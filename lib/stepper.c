@@ -165,6 +165,7 @@ static int compute_forces(odhs_stepper *st)
     if (!drv->pressure_on) return solve(st, b, net->f);
 
     /* fixed pressure: f = x2 + (gdot kappa / xi0) x1 with N x2 = b, N x1 = r */
+    st->work_pressure++;
     double *x1 = st->cx;
     if ((s = solve(st, b, net->f))) return s;
     memset(x1, 0, nc * sizeof *x1);
@@ -224,7 +225,7 @@ static void contact_geometry(odhs_stepper *st, size_t c)
     min_sep(st, net->ci[c], net->cj[c], d);
     double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     net->dist[c] = r;
-    net->gap[c] = r - (st->sys->r[net->ci[c]] + st->sys->r[net->cj[c]]);
+    net->gap[c] = r - odhs__net_sigma(net, st->sys, c);
     for (int k = 0; k < dim; ++k) net->nrm[c * dim + k] = d[k] / r;
     net->version++;
 }
@@ -433,7 +434,7 @@ static double predict(const odhs_stepper *st, const double *G, const double *vel
         /* quick reject: cannot close the gap within the current best time */
         double gap = sqrt(dd) - sig;
         if (gap > 0.0 && gap > best * sqrt(a)) continue;
-        if (odhs__net_find(st->net, i, j) != SIZE_MAX) continue;
+        if (odhs__net_find(st->net, i, j) != SIZE_MAX || odhs__same_body(st->net, i, j)) continue;
         double t;
         if (c <= 0.0) {
             /* touching (round-off): a collision now if really approaching */
@@ -498,7 +499,9 @@ static int snapshot(odhs_stepper *st)
         if (k) st->skind = k;
         double *f = odhs__realloc(st->sf, cap * sizeof *f);
         if (f) st->sf = f;
-        if (!a || !b || !k || !f) return sterr(st, ODHS_E_NOMEM, "out of memory");
+        double *rs = odhs__realloc(st->srest, cap * sizeof *rs);
+        if (rs) st->srest = rs;
+        if (!a || !b || !k || !f || !rs) return sterr(st, ODHS_E_NOMEM, "out of memory");
         st->scap = cap;
     }
     memcpy(st->xs, st->sys->x, st->nd * sizeof *st->xs);
@@ -519,6 +522,7 @@ static int snapshot(odhs_stepper *st)
     memcpy(st->scj, net->cj, net->nc * sizeof *st->scj);
     memcpy(st->skind, net->kind, net->nc * sizeof *st->skind);
     memcpy(st->sf, net->f, net->nc * sizeof *st->sf);
+    if (net->nperm) memcpy(st->srest, net->rest, net->nc * sizeof *st->srest);
     return ODHS_OK;
 }
 
@@ -536,6 +540,7 @@ static void rollback(odhs_stepper *st)
         size_t k = odhs__net_add(net, st->sci[c], st->scj[c], st->skind[c]);
         if (k == SIZE_MAX) break; /* cannot happen: capacity is retained */
         net->f[k] = st->sf[c];
+        if (st->skind[c] == ODHS_CONTACT_PERMANENT) net->rest[k] = st->srest[c];
     }
     odhs__net_geometry(net, st->sys);
     memcpy(st->G, st->Gs, sizeof st->G);
@@ -588,7 +593,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
     if (!st) return;
     odhs_network_destroy(st->net);
     void *arrays[] = {st->disps, st->U0, st->Ua, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
-                      st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->ev};
+                      st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->srest, st->ev};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
 }
@@ -689,7 +694,8 @@ int odhs_stepper_reset(odhs_stepper *st)
     odhs__net_geometry(net, st->sys);
     for (size_t c = net->nc; c-- > 0;) {
         double sig = st->sys->r[net->ci[c]] + st->sys->r[net->cj[c]];
-        if (net->kind[c] == ODHS_CONTACT_TEMPORARY && fabs(net->gap[c]) > fmax(1e-6, st->contact_tol) * sig)
+        if (net->kind[c] == ODHS_CONTACT_TEMPORARY &&
+            (fabs(net->gap[c]) > fmax(1e-6, st->contact_tol) * sig || odhs__same_body(net, net->ci[c], net->cj[c])))
             odhs__net_remove_at(net, c);
     }
     if ((s = odhs_network_detect(net, st->sys, st->contact_tol))) {
@@ -728,7 +734,7 @@ static int correct(odhs_stepper *st, int *added)
         if ((s = reserve_contacts(st, nc))) return sterr(st, s, "out of memory");
         double gmax = 0.0;
         for (size_t c = 0; c < nc; ++c)
-            gmax = fmax(gmax, fabs(net->gap[c]) / (sys->r[net->ci[c]] + sys->r[net->cj[c]]));
+            gmax = fmax(gmax, fabs(net->gap[c]) / odhs__net_sigma(net, sys, c));
         if (gmax <= 4e-16) return ODHS_OK;            /* at round-off */
         if (!(gmax < 0.5 * prev)) return ODHS_OK;     /* no further progress */
         int isostatic = 0;
@@ -847,9 +853,11 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         /* error estimate */
         double emax = 0.0;
         for (size_t i = 0; i < st->n && !s; ++i) {
-            double e2 = 0.0;
+            double e2 = 0.0, gu[3];
+            /* k2 - k1 = U* - U0 + tau G0 U0 (non-affine part) */
+            apply_G(G0, st->dim, st->U0 + i * st->dim, gu);
             for (int k = 0; k < st->dim; ++k) {
-                double dv = st->U[i * st->dim + k] - st->U0[i * st->dim + k];
+                double dv = st->U[i * st->dim + k] - st->U0[i * st->dim + k] + tau * gu[k];
                 e2 += dv * dv;
             }
             emax = fmax(emax, e2);
@@ -873,8 +881,17 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         st->nsolves_pred++;
         double fac = err > 0.0 ? 0.9 * sqrt(st->tol / err) : 2.0;
         if (err <= st->tol || attempt >= 40) {
-            /* accepted: chord velocity = average */
-            for (size_t k = 0; k < nd; ++k) st->Ua[k] = 0.5 * (st->U0[k] + st->U[k]);
+            /* accepted: the chord of Heun's x1 = x0 + tau/2 (k1 + k2) with
+             * k = G x + U: non-affine velocity (U0 + U*)/2 plus the advection
+             * of the non-affine displacement by the flow, tau/2 G0 U0 (the
+             * G G x part is the frame: the box deforms with the same G) */
+            int dim = st->dim;
+            for (size_t i = 0; i < st->n; ++i) {
+                double gu[3];
+                apply_G(G0, dim, st->U0 + i * dim, gu);
+                for (int a = 0; a < dim; ++a)
+                    st->Ua[i * dim + a] = 0.5 * (st->U0[i * dim + a] + st->U[i * dim + a]) + 0.5 * tau * gu[a];
+            }
             for (int a = 0; a < 9; ++a) Ga[a] = 0.5 * (G0[a] + Gs[a]);
             memcpy(st->U, st->U0, nd * sizeof *st->U);
             if (!truncated) st->h = fmin(st->dt, st->h * fmin(2.0, fac));
@@ -1294,15 +1311,32 @@ int odhs_stepper_coordination(const odhs_stepper *st, double *z)
 
 const odhs_network *odhs_stepper_network(const odhs_stepper *st) { return st ? st->net : NULL; }
 
+int odhs_stepper_feature_work(const odhs_stepper *st, int feature, uint64_t *count)
+{
+    NEED(st, count);
+    switch (feature) {
+    case ODHS_FEATURE_PRESSURE: *count = st->work_pressure; return ODHS_OK;
+    case ODHS_FEATURE_COMPOSITE: *count = st->net->work_composite; return ODHS_OK;
+    default: return sterr(st, ODHS_E_INVALID, "unknown feature %d", feature);
+    }
+}
+
 typedef struct {
     const double *r;
     double worst;
+    const odhs_network *net;
 } ov_ctx;
 
 static int ov_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
 {
     (void)rij;
     ov_ctx *c = vctx;
+    /* beads of a composite may overlap by design */
+    if (c->net->nperm) {
+        if (odhs__same_body(c->net, i, j)) return 0;
+        size_t k = odhs__net_find(c->net, i, j);
+        if (k != SIZE_MAX && c->net->kind[k] == ODHS_CONTACT_PERMANENT) return 0;
+    }
     double rel = -gap / (c->r[i] + c->r[j]);
     if (rel > c->worst) c->worst = rel;
     return 0;
@@ -1316,11 +1350,11 @@ int odhs_stepper_errors(const odhs_stepper *st, double *contact_gap, double *ove
     if (contact_gap) {
         double g = 0.0;
         for (size_t c = 0; c < net->nc; ++c)
-            g = fmax(g, fabs(net->gap[c]) / (s->r[net->ci[c]] + s->r[net->cj[c]]));
+            g = fmax(g, fabs(net->gap[c]) / odhs__net_sigma(net, s, c));
         *contact_gap = g;
     }
     if (overlap) {
-        ov_ctx c = {s->r, -INFINITY};
+        ov_ctx c = {s->r, -INFINITY, net};
         int r = odhs__pairs(s->dim, s->n, s->x, s->r, s->rmax, s->L, s->gamma, 0.0, ov_cb, &c);
         if (r == ODHS_E_NOMEM) return sterr(st, r, "out of memory");
         *overlap = c.worst > 0.0 ? c.worst : 0.0;

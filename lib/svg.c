@@ -96,16 +96,19 @@ int odhs_svg_write(const odhs_system *sys, const odhs_network *net, const unsign
     /* force chains */
     if (net && net->nc) {
         double fmax = 0.0;
-        for (size_t c = 0; c < net->nc; ++c) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
+        for (size_t c = 0; c < net->nc; ++c)
+            if (net->kind[c] == ODHS_CONTACT_TEMPORARY) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
         double wmax = 0.3 * v.s * sys->rmax;
         for (size_t c = 0; c < net->nc && ok; ++c) {
             size_t i = net->ci[c], j = net->cj[c];
             double dv[3] = {0, 0, 0};
             for (int a = 0; a < d; ++a) dv[a] = sys->x[j * d + a] - sys->x[i * d + a];
             odhs__min_image(d, sys->L, g, dv, NULL);
+            int bond = net->kind[c] == ODHS_CONTACT_PERMANENT;
             double w = fmax > 0.0 ? wmax * fabs(net->f[c]) / fmax : 1.0;
             if (w < 0.4) w = 0.4;
-            const char *dash = net->f[c] < 0.0 ? " stroke-dasharray=\"3,2\"" : "";
+            if (bond) w = 0.25 * wmax > 0.8 ? 0.25 * wmax : 0.8; /* bonds: fixed width, the body's skeleton */
+            const char *dash = !bond && net->f[c] < 0.0 ? " stroke-dasharray=\"3,2\"" : "";
             const char *col = net->kind[c] == ODHS_CONTACT_PERMANENT ? "#08306b" : "#000000";
             /* draw from both ends so contacts across the boundary show twice */
             for (int side = 0; side < 2; ++side) {

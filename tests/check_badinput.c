@@ -1100,6 +1100,27 @@ static int huge_rate_case(void)
     X(net_errmsg_null, odhs_network_errmsg, ODHS_OK, NOALT, H_NONE, 0,                                         \
       const char *m = odhs_network_errmsg(NULL); return m && !m[0] ? ODHS_OK : post("errmsg(NULL)");)          \
     X(net_add_null, odhs_network_add, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_network_add(NULL, 0, 1, 0);)  \
+    X(net_bond_null, odhs_network_add_bond, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_network_add_bond(NULL, 0, 1, 1.0);) \
+    X(net_bond_range, odhs_network_add_bond, ODHS_E_RANGE, NOALT, H_NET2, 0,                                   \
+      return odhs_network_add_bond(w->net2, 0, 16, 1.0);)                                                      \
+    X(net_bond_self, odhs_network_add_bond, ODHS_E_INVALID, NOALT, H_NET2, 0,                                  \
+      return odhs_network_add_bond(w->net2, 1, 1, 1.0);)                                                       \
+    X(net_bond_zero, odhs_network_add_bond, ODHS_E_INVALID, NOALT, H_NET3, 0,                                  \
+      return odhs_network_add_bond(w->net3, 0, 1, 0.0);)                                                       \
+    X(net_bond_nan, odhs_network_add_bond, ODHS_E_NONFINITE, NOALT, H_NET3, 0,                                 \
+      return odhs_network_add_bond(w->net3, 0, 1, NAN_);)                                                      \
+    X(net_bond_inf, odhs_network_add_bond, ODHS_E_NONFINITE, NOALT, H_NET3, 0,                                 \
+      return odhs_network_add_bond(w->net3, 0, 1, INF_);)                                                      \
+    X(net_rest_null, odhs_network_get_rest_length, ODHS_E_NULL, NOALT, H_NONE, 0,                              \
+      double v; return odhs_network_get_rest_length(NULL, w->sys2, 0, &v);)                                    \
+    X(net_rest_null_out, odhs_network_get_rest_length, ODHS_E_NULL, NOALT, H_NET2, 0,                          \
+      return odhs_network_get_rest_length(w->net2, w->sys2, 0, NULL);)                                         \
+    X(net_rest_null_sys, odhs_network_get_rest_length, ODHS_E_NULL, NOALT, H_NET2, 0,                          \
+      double v; return odhs_network_get_rest_length(w->net2, NULL, 0, &v);)                                    \
+    X(net_rest_range, odhs_network_get_rest_length, ODHS_E_RANGE, NOALT, H_NET2, 0,                            \
+      double v; return odhs_network_get_rest_length(w->net2, w->sys2, 100000, &v);)                            \
+    X(net_rest_dim, odhs_network_get_rest_length, ODHS_E_DIM, NOALT, H_NET2, 0,                                \
+      double v; return odhs_network_get_rest_length(w->net2, w->sys3, 0, &v);)                                 \
     X(net_add_range_i, odhs_network_add, ODHS_E_RANGE, NOALT, H_NET2, 0, return odhs_network_add(w->net2, 16, 1, 0);) \
     X(net_add_range_j, odhs_network_add, ODHS_E_RANGE, NOALT, H_NET3, 0, return odhs_network_add(w->net3, 0, SIZE_MAX, 0);) \
     X(net_add_self, odhs_network_add, ODHS_E_INVALID, NOALT, H_NET2, 0, return odhs_network_add(w->net2, 3, 3, 0);) \
@@ -1503,6 +1524,45 @@ static int huge_rate_case(void)
       return odhs_stepper_set_tolerance(w->run, NAN_);)                                                        \
     X(st_corr_null, odhs_stepper_set_correction_interval, ODHS_E_NULL, NOALT, H_NONE, 0,                       \
       return odhs_stepper_set_correction_interval(NULL, 5);)                                                   \
+    X(st_bond_null, odhs_stepper_add_bond, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_stepper_add_bond(NULL, 0, 1, 0.0);) \
+    X(st_bond_range, odhs_stepper_add_bond, ODHS_E_RANGE, NOALT, H_RUN, 0, return odhs_stepper_add_bond(w->run, 0, 16, 0.0);) \
+    X(st_bond_self, odhs_stepper_add_bond, ODHS_E_INVALID, NOALT, H_RUN, 0, return odhs_stepper_add_bond(w->run, 2, 2, 0.0);) \
+    X(st_bond_negative, odhs_stepper_add_bond, ODHS_E_INVALID, NOALT, H_RUN, 0,                                \
+      return odhs_stepper_add_bond(w->run, 0, 1, -1.0);)                                                       \
+    X(st_bond_nan, odhs_stepper_add_bond, ODHS_E_NONFINITE, NOALT, H_RUN, 0,                                   \
+      return odhs_stepper_add_bond(w->run, 0, 1, NAN_);)                                                       \
+    X(st_bond_far, odhs_stepper_add_bond, ODHS_E_INVALID, NOALT, H_RUN, 0,                                     \
+      return odhs_stepper_add_bond(w->run, 0, 1, 1e6);)                                                        \
+    X(st_chain_null, odhs_stepper_add_chain, ODHS_E_NULL, NOALT, H_NONE, 0,                                    \
+      size_t b[2] = {0, 1}; return odhs_stepper_add_chain(NULL, 2, b);)                                        \
+    X(st_chain_null_beads, odhs_stepper_add_chain, ODHS_E_NULL, NOALT, H_RUN, 0,                               \
+      return odhs_stepper_add_chain(w->run, 2, NULL);)                                                         \
+    X(st_chain_short, odhs_stepper_add_chain, ODHS_E_INVALID, NOALT, H_RUN, 0,                                 \
+      size_t b[1] = {0}; return odhs_stepper_add_chain(w->run, 1, b);)                                         \
+    X(st_chain_range, odhs_stepper_add_chain, ODHS_E_RANGE, NOALT, H_RUN, 0,                                   \
+      size_t b[3] = {0, 1, 99}; return odhs_stepper_add_chain(w->run, 3, b);)                                  \
+    X(st_chain_repeat, odhs_stepper_add_chain, ODHS_E_INVALID, NOALT, H_RUN, 0,                                \
+      size_t b[3] = {0, 1, 0}; return odhs_stepper_add_chain(w->run, 3, b);)                                   \
+    X(st_body_null, odhs_stepper_add_rigid_body, ODHS_E_NULL, NOALT, H_NONE, 0,                                \
+      size_t b[2] = {0, 1}; return odhs_stepper_add_rigid_body(NULL, 2, b);)                                   \
+    X(st_body_null_beads, odhs_stepper_add_rigid_body, ODHS_E_NULL, NOALT, H_RUN, 0,                           \
+      return odhs_stepper_add_rigid_body(w->run, 3, NULL);)                                                    \
+    X(st_body_short, odhs_stepper_add_rigid_body, ODHS_E_INVALID, NOALT, H_RUN, 0,                             \
+      size_t b[1] = {0}; return odhs_stepper_add_rigid_body(w->run, 1, b);)                                    \
+    X(st_body_range, odhs_stepper_add_rigid_body, ODHS_E_RANGE, NOALT, H_RUN, 0,                               \
+      size_t b[2] = {SIZE_MAX, 1}; return odhs_stepper_add_rigid_body(w->run, 2, b);)                          \
+    X(st_body_repeat, odhs_stepper_add_rigid_body, ODHS_E_INVALID, NOALT, H_RUN, 0,                            \
+      size_t b[3] = {4, 5, 4}; return odhs_stepper_add_rigid_body(w->run, 3, b);)                              \
+    X(st_feature_null, odhs_stepper_feature_work, ODHS_E_NULL, NOALT, H_NONE, 0,                               \
+      uint64_t c; return odhs_stepper_feature_work(NULL, ODHS_FEATURE_PRESSURE, &c);)                          \
+    X(st_feature_null_out, odhs_stepper_feature_work, ODHS_E_NULL, NOALT, H_RUN, 0,                            \
+      return odhs_stepper_feature_work(w->run, ODHS_FEATURE_PRESSURE, NULL);)                                  \
+    X(st_feature_unknown, odhs_stepper_feature_work, ODHS_E_INVALID, NOALT, H_RUN, 0,                          \
+      uint64_t c; return odhs_stepper_feature_work(w->run, 0, &c);)                                            \
+    X(st_bondcount_null, odhs_stepper_bond_count, ODHS_E_NULL, NOALT, H_NONE, 0,                               \
+      size_t c; return odhs_stepper_bond_count(NULL, &c);)                                                     \
+    X(st_bondcount_null_out, odhs_stepper_bond_count, ODHS_E_NULL, NOALT, H_RUN, 0,                            \
+      return odhs_stepper_bond_count(w->run, NULL);)                                                           \
     X(st_ctol_null, odhs_stepper_set_contact_tolerance, ODHS_E_NULL, NOALT, H_NONE, 0,                         \
       return odhs_stepper_set_contact_tolerance(NULL, 1e-9);)                                                  \
     X(st_ctol_negative, odhs_stepper_set_contact_tolerance, ODHS_E_INVALID, NOALT, H_ST, 0,                    \

@@ -52,5 +52,15 @@ expect 0 "jam_packing compress" -- "$bin/jam_packing" --n 32 --svg "$tmp/j.svg" 
 expect_in out "jammed                 yes" "jam_packing certifies a jammed packing"
 head -c 4 "$tmp/j.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: jam_packing svg"; fail=$((fail + 1)); }
 grep -q "^# libodhs contacts" "$tmp/j.con" && pass=$((pass + 1)) || { echo "FAIL: jam_packing contacts"; fail=$((fail + 1)); }
+expect 0 "composite help" -- "$bin/composite" --help
+expect_in out "usage: composite" "composite --help prints usage"
+expect 2 "composite bad beads" -- "$bin/composite" --beads 5
+expect 2 "composite unknown option" -- "$bin/composite" --no-such-option
+expect 0 "composite dimers" -- "$bin/composite" --bodies 20 --beads 2 --phi 0.5 --strain 0.05 --every 0.05 \
+    --series "$tmp/cp.csv" --svg "$tmp/cp.svg" --out "$tmp/cp.xyz"
+expect_in cp.csv "^strain,shear_stress,pressure,z,events,bond_error" "composite writes its series header"
+head -c 4 "$tmp/cp.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: composite svg"; fail=$((fail + 1)); }
+# rigid bodies: the bond error column stays at round-off
+awk -F, 'NR > 1 && $6 > 1e-12 { bad = 1 } END { exit bad }' "$tmp/cp.csv" && pass=$((pass + 1)) || { echo "FAIL: composite bond error"; fail=$((fail + 1)); }
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

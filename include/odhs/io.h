@@ -53,7 +53,8 @@ struct odhs_network; /* see network.h */
  * discs coloured by size (below/above the median radius; 3D systems are
  * projected on the x-y plane), the periodic (sheared) cell, and, when net is
  * not NULL, every contact as a line from centre to centre whose width is
- * proportional to its force (negative forces of permanent contacts dashed).
+ * proportional to its force, and every permanent contact (bond) as a thin
+ * dark-blue line of fixed width.
  * mark (N flags, may be NULL) highlights particles: 1 = grey with a red ring
  * (rattlers), 2 = dark red (e.g. a clogging arch). The file is written to a
  * temporary name and renamed. Errors: ODHS_E_NULL, ODHS_E_STATE, ODHS_E_DIM,

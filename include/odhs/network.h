@@ -42,6 +42,19 @@ ODHS_API const char *odhs_network_errmsg(const odhs_network *net);
 /** Add the contact (i,j) of the given kind (ODHS_CONTACT_*). Errors:
  *  ODHS_E_RANGE, ODHS_E_INVALID (i == j, bad kind, already present). */
 ODHS_API int odhs_network_add(odhs_network *net, size_t i, size_t j, int kind);
+/**
+ * Add a permanent contact (a bond of a composite particle, Sect. V C) between
+ * i and j held at the centre distance `rest` (> 0) instead of a_i + a_j, so
+ * that beads may overlap or stand apart. If (i,j) is a temporary contact it
+ * becomes permanent. Errors: ODHS_E_RANGE, ODHS_E_INVALID (i == j, already
+ * bonded, rest <= 0), ODHS_E_NONFINITE. Permanent contacts added with
+ * odhs_network_add keep the rest length a_i + a_j.
+ */
+ODHS_API int odhs_network_add_bond(odhs_network *net, size_t i, size_t j, double rest);
+/** Target distance of contact k: its rest length for a bond, else a_i + a_j
+ *  (radii read from sys). */
+ODHS_API int odhs_network_get_rest_length(const odhs_network *net, const odhs_system *sys, size_t k,
+                                          double *rest);
 /** Remove the contact (i,j). ODHS_E_INVALID if absent. */
 ODHS_API int odhs_network_remove(odhs_network *net, size_t i, size_t j);
 /** Remove every contact. */
@@ -94,7 +107,12 @@ ODHS_API int odhs_network_coordination(const odhs_network *net, double *z);
 /**
  * Constrained subset (Sect. IV D): particles with at least d+1 contacts to
  * other particles of the subset, found by iterative removal (integer
- * arithmetic). Outputs (any may be NULL): *nbar its size, *ncon the number of
+ * arithmetic). With permanent contacts the unit is a body (a connected
+ * component of the permanent contacts): a body of k beads with p internal
+ * contacts has dof = d k - p degrees of freedom (at least d for a particle, 3
+ * in 2D, 5 for a dimer and 6 otherwise in 3D) and stays in the subset with at
+ * least dof + 1 contacts to other bodies of the subset; its beads are in or out
+ * together and its internal contacts count in Ncon. Outputs (any may be NULL): *nbar its size, *ncon the number of
  * contacts inside it, in_subset[N] flags (1 = constrained), and *zbar_num,
  * the numerator 2(d-1) + sum_i zbar_i of eq. (29) so that zbar = zbar_num/nbar.
  * Particles outside the subset are the rattlers (and loosely connected ones).

@@ -97,6 +97,36 @@ ODHS_API int odhs_stepper_set_contact_tolerance(odhs_stepper *st, double tol);
 /** Event callback (NULL removes). */
 ODHS_API int odhs_stepper_set_event_callback(odhs_stepper *st, odhs_event_fn fn, void *ctx);
 
+/* ---- composite particles (Sect. V C) ------------------------------------
+ * Bonds are permanent contacts: rows of S that never open and may carry a
+ * negative force, held at a rest length by the same drift correction as the
+ * contacts. Adding bonds invalidates the current forces: the next step (or
+ * odhs_stepper_reset) re-solves them. On any error nothing is added. */
+
+/** Bond particles i and j at centre distance `rest` (> 0), or at their current
+ *  distance when rest == 0. The pair must be within half a rest length of rest
+ *  and closer than half the shortest box edge. A temporary contact (i,j)
+ *  becomes the bond. Errors: ODHS_E_RANGE, ODHS_E_INVALID (i == j, already
+ *  bonded, too far), ODHS_E_NONFINITE. */
+ODHS_API int odhs_stepper_add_bond(odhs_stepper *st, size_t i, size_t j, double rest);
+/** A floppy chain: bonds between consecutive beads[0..k-1] (k >= 2) at their
+ *  current distances. */
+ODHS_API int odhs_stepper_add_chain(odhs_stepper *st, size_t k, const size_t *beads);
+/**
+ * A rigid body of the k >= 2 particles beads[] at their current relative
+ * positions: a minimal infinitesimally rigid set of bonds (each bead bonded to
+ * d earlier ones along independent directions: 2k-3 bonds in 2D, 3k-6 in 3D,
+ * one for a dimer), since any further bond would be redundant and make N
+ * singular. Pairs of beads of one rigid body never become temporary contacts
+ * and never collide. ODHS_E_INVALID if a bead already belongs to a rigid body
+ * or the beads are (nearly) collinear (2D) or coplanar (3D, k >= 4): distance
+ * constraints cannot make a straight rod of 3 or more beads rigid (use a
+ * dimer, a chain, or beads off one line).
+ */
+ODHS_API int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads);
+/** Number of permanent contacts (bonds). */
+ODHS_API int odhs_stepper_bond_count(const odhs_stepper *st, size_t *count);
+
 /**
  * (Re)build the initial contact network from the system (pairs within the
  * contact tolerance), compute the valid network, forces and velocities. Called
@@ -167,6 +197,17 @@ ODHS_API int odhs_stepper_velocities(const odhs_stepper *st, double *V);
 ODHS_API int odhs_stepper_nonaffine_velocities(const odhs_stepper *st, double *U);
 /** Mean coordination z = 2 Nc / N. */
 ODHS_API int odhs_stepper_coordination(const odhs_stepper *st, double *z);
+/** Optional features whose code a scene runs only when it uses them (pinned
+ *  values; more may be added). */
+enum {
+    ODHS_FEATURE_PRESSURE = 1,  /* pressure control: the extra solve for kappa  */
+    ODHS_FEATURE_COMPOSITE = 2  /* bonds: rest lengths, body-level subset       */
+};
+/** How many times the stepper ran the code of an optional feature: passes of
+ *  the pressure-control solve, or passes over bond rest lengths and rebuilds
+ *  of the body-level constrained subset. A scene that does not use a feature
+ *  reads 0: it pays nothing for it. ODHS_E_INVALID for an unknown feature. */
+ODHS_API int odhs_stepper_feature_work(const odhs_stepper *st, int feature, uint64_t *count);
 /** The current contact network (owned by the stepper; read only). */
 ODHS_API const odhs_network *odhs_stepper_network(const odhs_stepper *st);
 /** Largest |gap|/(a_i+a_j) over contacts and the largest overlap
