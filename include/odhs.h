@@ -12,6 +12,7 @@
 #include "odhs/solver.h"
 #include "odhs/driver.h"
 #include "odhs/stepper.h"
+#include "odhs/walls.h"
 #include "odhs/jamming.h"
 #include "odhs/checkpoint.h"
 

@@ -133,6 +133,22 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
         put_u64(&b, st->pi[p]);
         put_u64(&b, st->pj[p]);
     }
+    /* optional: walls (before the contacts that refer to them) */
+    if (net->nwalls) {
+        put_tag(&b, "WAL ");
+        put_u64(&b, net->nwalls);
+        for (size_t w = 0; w < net->nwalls; ++w) {
+            const odhs_wall *wl = &net->walls[w];
+            put_u64(&b, (uint64_t)wl->type);
+            put_f64s(&b, wl->n, 3);
+            put_f64(&b, wl->h);
+            put_f64s(&b, wl->c, 3);
+            put_f64s(&b, wl->b, 3);
+            put_f64(&b, wl->R);
+            put_f64s(&b, wl->v, 3);
+            put_f64s(&b, wl->disp, 3);
+        }
+    }
     /* network, in its order */
     put_tag(&b, "NET ");
     put_u64(&b, net->nc);
@@ -411,6 +427,31 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         st->pj[q] = (size_t)j;
     }
     st->npairs = (size_t)npairs;
+    /* walls */
+    if (peek_tag(&b, "WAL ")) {
+        tag(&b, "WAL ");
+        uint64_t nw = get_u64(&b);
+        if (b.bad || nw > (b.len - b.pos) / 8) FAIL(ODHS_E_FORMAT, "checkpoint: bad wall count");
+        for (uint64_t w = 0; w < nw; ++w) {
+            odhs_wall wl;
+            memset(&wl, 0, sizeof wl);
+            uint64_t type = get_u64(&b);
+            get_f64s(&b, wl.n, 3);
+            wl.h = get_f64(&b);
+            get_f64s(&b, wl.c, 3);
+            get_f64s(&b, wl.b, 3);
+            wl.R = get_f64(&b);
+            get_f64s(&b, wl.v, 3);
+            get_f64s(&b, wl.disp, 3);
+            if (b.bad || type > ODHS_WALL_SEGMENT || !finite_all(wl.n, 3) || !isfinite(wl.h) ||
+                !finite_all(wl.c, 3) || !finite_all(wl.b, 3) || !isfinite(wl.R) || !finite_all(wl.v, 3) ||
+                !finite_all(wl.disp, 3) || (type == ODHS_WALL_SPHERE && !(wl.R > 0.0)) ||
+                (type == ODHS_WALL_SEGMENT && dim != 2))
+                FAIL(ODHS_E_FORMAT, "checkpoint: bad wall %llu", (unsigned long long)w);
+            wl.type = (int)type;
+            if (odhs__net_add_wall(st->net, &wl)) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
+        }
+    }
     /* network */
     if (tag(&b, "NET ")) FAIL(ODHS_E_FORMAT, "checkpoint: network section missing");
     uint64_t nc = get_u64(&b);
@@ -418,7 +459,9 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     for (size_t c = 0; c < nc; ++c) {
         uint64_t i = get_u64(&b), j = get_u64(&b), kind = get_u64(&b);
         double f = get_f64(&b);
-        if (b.bad || i >= j || j >= n || kind > ODHS_CONTACT_PERMANENT || !isfinite(f))
+        int wall = j >= n;
+        if (b.bad || i >= j || i >= n || j >= n + st->net->nwalls || kind > ODHS_CONTACT_WALL ||
+            (kind == ODHS_CONTACT_WALL) != wall || !isfinite(f))
             FAIL(ODHS_E_FORMAT, "checkpoint: bad contact %zu", c);
         if (odhs__net_find(st->net, (size_t)i, (size_t)j) != SIZE_MAX)
             FAIL(ODHS_E_FORMAT, "checkpoint: duplicate contact (%llu,%llu)", (unsigned long long)i,

@@ -106,6 +106,62 @@ int odhs__pairs(int dim, size_t n, const double *x, const double *r, double rmax
 
 #endif /* ODHS_INTERNAL_H */
 
+/* ---- hard walls ------------------------------------------------------------ */
+typedef struct {
+    int type;     /* ODHS_WALL_* */
+    double n[3];  /* plane: unit normal into the allowed side; segment: unit normal of the line */
+    double h;     /* plane: particles where n.x >= h */
+    double c[3];  /* sphere: centre; segment: end a */
+    double b[3];  /* segment: end b */
+    double R;     /* sphere: radius (particles inside) */
+    double v[3];  /* velocity (translation) */
+    double disp[3]; /* displacement since creation */
+} odhs_wall;
+
+/* Distance from a particle centre x to the wall surface (positive on the
+ * allowed side) and the unit contact normal nrm from the particle towards
+ * the wall. */
+static inline double odhs__wall_geom(const odhs_wall *w, int dim, const double *x, double *nrm)
+{
+    if (w->type == ODHS_WALL_PLANE) {
+        double s = -w->h;
+        for (int k = 0; k < dim; ++k) {
+            s += w->n[k] * x[k];
+            nrm[k] = -w->n[k];
+        }
+        return s;
+    }
+    double p[3] = {0, 0, 0};
+    if (w->type == ODHS_WALL_SPHERE) {
+        double r2 = 0.0;
+        for (int k = 0; k < dim; ++k) {
+            p[k] = x[k] - w->c[k];
+            r2 += p[k] * p[k];
+        }
+        double r = sqrt(r2);
+        for (int k = 0; k < dim; ++k) nrm[k] = r > 0.0 ? p[k] / r : (k == 0 ? 1.0 : 0.0);
+        return w->R - r;
+    }
+    /* segment: closest point q = a + t (b - a), t in [0,1] */
+    double ab[3] = {0, 0, 0}, ax[3] = {0, 0, 0}, l2 = 0.0, t = 0.0;
+    for (int k = 0; k < dim; ++k) {
+        ab[k] = w->b[k] - w->c[k];
+        ax[k] = x[k] - w->c[k];
+        l2 += ab[k] * ab[k];
+        t += ab[k] * ax[k];
+    }
+    t = l2 > 0.0 ? t / l2 : 0.0;
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    double r2 = 0.0;
+    for (int k = 0; k < dim; ++k) {
+        p[k] = w->c[k] + t * ab[k] - x[k];
+        r2 += p[k] * p[k];
+    }
+    double r = sqrt(r2);
+    for (int k = 0; k < dim; ++k) nrm[k] = r > 0.0 ? p[k] / r : 0.0;
+    return r;
+}
+
 /* ---- contact network ----------------------------------------------------- */
 struct odhs_network {
     int dim;
@@ -138,6 +194,13 @@ struct odhs_network {
      * contacts), recomputed on demand when nperm > 0; cached by version */
     uint64_t topo;         /* bumped when contacts are added, removed or change kind */
     uint64_t work_composite; /* passes of composite-only code (odhs_stepper_feature_work) */
+    /* hard walls: contacts (i, n + w) of kind ODHS_CONTACT_WALL; the per-node
+     * arrays (adj, core, cdeg, mark, work) have room for n + nwalls nodes and
+     * wall nodes are always in the constrained subset */
+    odhs_wall *walls;
+    size_t nwalls;
+    size_t free_modes;       /* global zero modes: d without walls */
+    uint64_t work_walls;     /* passes of wall-only code */
     int bc_valid;
     uint64_t bc_topo;
     unsigned char *bcore;  /* n flags */
@@ -148,9 +211,16 @@ struct odhs_network {
 /* target distance of contact c: a_i + a_j, or a permanent contact's rest length */
 static inline double odhs__net_sigma(const odhs_network *net, const odhs_system *sys, size_t c)
 {
+    if (net->nwalls && net->cj[c] >= net->n) return sys->r[net->ci[c]];
     if (net->nperm && net->kind[c] == ODHS_CONTACT_PERMANENT && !isnan(net->rest[c])) return net->rest[c];
     return sys->r[net->ci[c]] + sys->r[net->cj[c]];
 }
+/* contacts that open when their force would be negative */
+static inline int odhs__can_open(int kind) { return kind != ODHS_CONTACT_PERMANENT; }
+/* add a wall to a network (grows the per-node arrays) */
+int odhs__net_add_wall(odhs_network *net, const odhs_wall *w);
+/* give a scratch copy `sub` of net's particles the same walls */
+int odhs__net_copy_walls(odhs_network *sub, const odhs_network *net);
 /* whether particles i and j belong to the same rigid body */
 static inline int odhs__same_body(const odhs_network *net, size_t i, size_t j)
 {
@@ -282,6 +352,8 @@ struct odhs_stepper {
     int *skind;
     double *sf;
     double *srest;    /* rest lengths (copied only with permanent contacts) */
+    odhs_wall *wsnap; /* walls at the snapshot */
+    size_t wsnapcap;
     size_t snc, scap;
     /* events of the last step */
     odhs_event *ev;

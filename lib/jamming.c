@@ -27,7 +27,7 @@ static int subset_contacts(const odhs_network *net, size_t **idx, size_t *m)
     }
     size_t k = 0;
     for (size_t c = 0; c < net->nc; ++c)
-        if (in[net->ci[c]] && in[net->cj[c]]) list[k++] = c;
+        if (in[net->ci[c]] && (net->cj[c] >= net->n || in[net->cj[c]])) list[k++] = c;
     odhs__free(in);
     *idx = list;
     *m = k;
@@ -58,7 +58,7 @@ static int null_dense(const odhs_network *net, const size_t *idx, size_t m, doub
             double dot = 0.0;
             for (int k = 0; k < d; ++k) dot += na[k] * nb[k];
             if (net->ci[ca] == net->ci[cb]) v += dot;
-            if (net->cj[ca] == net->cj[cb]) v += dot;
+            if (net->cj[ca] == net->cj[cb] && net->cj[ca] < net->n) v += dot; /* walls have no block */
             if (net->ci[ca] == net->cj[cb]) v -= dot;
             if (net->cj[ca] == net->ci[cb]) v -= dot;
             A[b * m + a] = v; /* (row a, column b), a <= b: upper triangle, column-major */
@@ -89,7 +89,7 @@ static int null_sparse(const odhs_network *net, odhs_solver *solver, const size_
     double *g = odhs__calloc(net->n * (size_t)d, sizeof *g);
     double *x = odhs__calloc(m, sizeof *x);
     int st = ODHS_OK;
-    if (!sub || !g || !x) {
+    if (!sub || !g || !x || odhs__net_copy_walls(sub, net)) {
         st = ODHS_E_NOMEM;
         goto done;
     }
@@ -102,6 +102,7 @@ static int null_sparse(const odhs_network *net, odhs_solver *solver, const size_
             goto done;
         }
         memcpy(sub->nrm + s * d, net->nrm + c * d, (size_t)d * sizeof(double));
+        sub->rest[s] = net->rest[c];
         sub->dist[s] = net->dist[c];
         sub->gap[s] = net->gap[c];
     }
@@ -110,7 +111,7 @@ static int null_sparse(const odhs_network *net, odhs_solver *solver, const size_
     size_t ck = idx[kk];
     for (int k = 0; k < d; ++k) {
         g[net->ci[ck] * d + k] = net->nrm[ck * d + k];
-        g[net->cj[ck] * d + k] = -net->nrm[ck * d + k];
+        if (net->cj[ck] < net->n) g[net->cj[ck] * d + k] = -net->nrm[ck * d + k];
     }
     st = odhs_solver_solve_ls(solver, sub, g, x);
     if (st) goto done;
@@ -211,17 +212,19 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
     odhs_network *sub = odhs__net_new(d, net->n);
     double *y = odhs__calloc(nc, sizeof *y), *dR = odhs__calloc(nd, sizeof *dR);
     size_t *map = odhs__malloc_array(nc, sizeof *map);
-    if (!sub || !y || !dR || !map) {
+    if (!sub || !y || !dR || !map || odhs__net_copy_walls(sub, net)) {
         st = ODHS_E_NOMEM;
         goto done;
     }
     for (size_t c = 0; c < nc; ++c) {
         if (c == k) continue;
         map[sub->nc] = c;
-        if (odhs__net_add(sub, net->ci[c], net->cj[c], net->kind[c]) == SIZE_MAX) {
+        size_t sc = odhs__net_add(sub, net->ci[c], net->cj[c], net->kind[c]);
+        if (sc == SIZE_MAX) {
             st = ODHS_E_NOMEM;
             goto done;
         }
+        sub->rest[sc] = net->rest[c];
     }
     double prev = INFINITY;
     for (int pass = 0; pass < 12; ++pass) {
@@ -234,8 +237,9 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
         }
         if (gmax <= 2e-16 || !(gmax < 0.5 * prev)) break;
         prev = gmax;
-        /* affine part: rescale box and positions about the origin */
-        double s = 1.0 - fg / fr;
+        /* affine part: rescale box and positions about the origin (not
+         * with walls, which do not scale: that gap component then stays) */
+        double s = net->nwalls ? 1.0 : 1.0 - fg / fr;
         for (int a = 0; a < d; ++a) sys->L[a] *= s;
         for (size_t q = 0; q < nd; ++q) sys->x[q] *= s;
         odhs__net_geometry(net, sys);
@@ -326,10 +330,10 @@ int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert)
     for (size_t k = 0; k < net->nc; ++k) {
         fr += net->f[k] * net->dist[k];
         c.gap_error = fmax(c.gap_error, fabs(net->gap[k]) / odhs__net_sigma(net, sys, k));
-        if (in[net->ci[k]] && in[net->cj[k]]) {
+        if (in[net->ci[k]] && (net->cj[k] >= n || in[net->cj[k]])) {
             fsum += net->f[k];
             /* bonds may carry any sign: the smallest force is over contacts */
-            if (net->kind[k] == ODHS_CONTACT_TEMPORARY) fmin = fmin < net->f[k] ? fmin : net->f[k];
+            if (odhs__can_open(net->kind[k])) fmin = fmin < net->f[k] ? fmin : net->f[k];
         }
     }
     c.pressure = fr / (vol * d);
@@ -377,8 +381,10 @@ int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const c
         size_t i = net->ci[c], j = net->cj[c];
         double v[3] = {0, 0, 0};
         int img[3] = {0, 0, 0};
-        for (int a = 0; a < d; ++a) v[a] = sys->x[j * d + a] - sys->x[i * d + a];
-        odhs__min_image(d, sys->L, sys->gamma, v, img);
+        if (j < net->n) { /* walls (j = N + w) have no image shift */
+            for (int a = 0; a < d; ++a) v[a] = sys->x[j * d + a] - sys->x[i * d + a];
+            odhs__min_image(d, sys->L, sys->gamma, v, img);
+        }
         if (d == 2)
             ok &= fprintf(f, "%zu %zu %d %d %.17g %.17g\n", i, j, img[0], img[1], net->f[c], net->gap[c]) > 0;
         else

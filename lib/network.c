@@ -16,6 +16,8 @@ int odhs__neterr(const odhs_network *net, int status, const char *fmt, ...)
 
 static inline uint64_t pair_key(const odhs_network *net, size_t i, size_t j)
 {
+    if (j >= net->n) /* wall contact (i, n + w): a key range of its own */
+        return ((uint64_t)1 << 62) + (uint64_t)(j - net->n) * (uint64_t)net->n + (uint64_t)i + 1u;
     return (uint64_t)i * (uint64_t)net->n + (uint64_t)j + 1u;
 }
 
@@ -89,6 +91,7 @@ odhs_network *odhs__net_new(int dim, size_t n)
     if (!net) return NULL;
     net->dim = dim;
     net->n = n;
+    net->free_modes = (size_t)dim;
     net->adj = odhs__calloc(n, sizeof *net->adj);
     net->adjn = odhs__calloc(n, sizeof *net->adjn);
     net->adjcap = odhs__calloc(n, sizeof *net->adjcap);
@@ -129,7 +132,8 @@ void odhs_network_destroy(odhs_network *net)
     odhs__free(net->hkey);
     odhs__free(net->hval);
     if (net->adj)
-        for (size_t i = 0; i < net->n; ++i) odhs__free(net->adj[i]);
+        for (size_t i = 0; i < net->n + net->nwalls; ++i) odhs__free(net->adj[i]);
+    odhs__free(net->walls);
     odhs__free(net->adj);
     odhs__free(net->adjn);
     odhs__free(net->adjcap);
@@ -204,7 +208,7 @@ static void core_peel(odhs_network *net, size_t qt)
     size_t need = (size_t)net->dim + 1, qh = 0, *q = net->work;
     while (qh < qt) {
         size_t x = q[qh++];
-        if (!net->core[x] || net->cdeg[x] >= need) continue;
+        if (x >= net->n || !net->core[x] || net->cdeg[x] >= need) continue; /* walls stay */
         net->core[x] = 0;
         net->nbar--;
         for (uint32_t k = 0; k < net->adjn[x]; ++k) {
@@ -435,6 +439,12 @@ void odhs__net_geometry(odhs_network *net, const odhs_system *sys)
     if (net->nperm) net->work_composite++; /* rest lengths of bonds */
     for (size_t c = 0; c < net->nc; ++c) {
         size_t i = net->ci[c], j = net->cj[c];
+        if (j >= net->n) {
+            double r = odhs__wall_geom(&net->walls[j - net->n], d, sys->x + i * d, net->nrm + c * d);
+            net->dist[c] = r;
+            net->gap[c] = r - sys->r[i];
+            continue;
+        }
         double v[3] = {0, 0, 0};
         for (int k = 0; k < d; ++k) v[k] = sys->x[j * d + k] - sys->x[i * d + k];
         odhs__min_image(d, sys->L, sys->gamma, v, NULL);
@@ -502,6 +512,16 @@ int odhs_network_detect(odhs_network *net, const odhs_system *sys, double tol)
         while (net->nc > nc0) odhs__net_remove_at(net, net->nc - 1);
         return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
     }
+    for (size_t w = 0; w < net->nwalls; ++w)
+        for (size_t i = 0; i < sys->n; ++i) {
+            double nrm[3];
+            double g = odhs__wall_geom(&net->walls[w], sys->dim, sys->x + i * sys->dim, nrm) - sys->r[i];
+            if (g <= tol * 2.0 * sys->r[i] && odhs__net_find(net, i, sys->n + w) == SIZE_MAX &&
+                odhs__net_add(net, i, sys->n + w, ODHS_CONTACT_WALL) == SIZE_MAX) {
+                while (net->nc > nc0) odhs__net_remove_at(net, net->nc - 1);
+                return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+            }
+        }
     odhs__net_geometry(net, sys);
     return ODHS_OK;
 }
@@ -551,6 +571,20 @@ int odhs_network_set_forces(odhs_network *net, const double *f)
 void odhs__net_S(const odhs_network *net, const double *v, double *out)
 {
     const int d = net->dim;
+    if (net->nwalls) {
+        for (size_t c = 0; c < net->nc; ++c) {
+            const double *n = net->nrm + c * d;
+            const double *vi = v + net->ci[c] * d;
+            double s = 0.0;
+            if (net->cj[c] < net->n) {
+                const double *vj = v + net->cj[c] * d;
+                for (int k = 0; k < d; ++k) s += vj[k] * n[k];
+            }
+            for (int k = 0; k < d; ++k) s -= vi[k] * n[k];
+            out[c] = s;
+        }
+        return;
+    }
     for (size_t c = 0; c < net->nc; ++c) {
         const double *n = net->nrm + c * d;
         const double *vi = v + net->ci[c] * d, *vj = v + net->cj[c] * d;
@@ -564,6 +598,18 @@ void odhs__net_ST(const odhs_network *net, const double *f, double *out)
 {
     const int d = net->dim;
     memset(out, 0, net->n * (size_t)d * sizeof(double));
+    if (net->nwalls) {
+        for (size_t c = 0; c < net->nc; ++c) {
+            const double *n = net->nrm + c * d;
+            double *oi = out + net->ci[c] * d;
+            for (int k = 0; k < d; ++k) oi[k] -= f[c] * n[k];
+            if (net->cj[c] < net->n) {
+                double *oj = out + net->cj[c] * d;
+                for (int k = 0; k < d; ++k) oj[k] += f[c] * n[k];
+            }
+        }
+        return;
+    }
     for (size_t c = 0; c < net->nc; ++c) {
         const double *n = net->nrm + c * d;
         double *oi = out + net->ci[c] * d, *oj = out + net->cj[c] * d;
@@ -610,7 +656,14 @@ int odhs_network_apply_N(const odhs_network *net, const double *x, double *out, 
     return ODHS_OK;
 }
 
-size_t odhs_network_nnz(const odhs_network *net) { return net ? net->nc * 2u * (size_t)net->dim : 0; }
+size_t odhs_network_nnz(const odhs_network *net)
+{
+    if (!net) return 0;
+    size_t rows = 2u * net->nc;
+    if (net->nwalls)
+        for (size_t c = 0; c < net->nc; ++c) rows -= net->cj[c] >= net->n;
+    return rows * (size_t)net->dim;
+}
 
 int odhs_network_get_S_csr(const odhs_network *net, size_t *rowptr, size_t *col, double *val)
 {
@@ -625,7 +678,7 @@ int odhs_network_get_S_csr(const odhs_network *net, size_t *rowptr, size_t *col,
             col[p] = a * d + k;
             val[p++] = -net->nrm[c * d + k];
         }
-        for (int k = 0; k < d; ++k) {
+        for (int k = 0; k < d && b < net->n; ++k) {
             col[p] = b * d + k;
             val[p++] = net->nrm[c * d + k];
         }
@@ -699,6 +752,10 @@ int odhs__net_body_core(const odhs_network *cnet)
     size_t *inner = q; /* reused as the queue afterwards */
     for (size_t b = 0; b < nb; ++b) inner[b] = 0;
     for (size_t c = 0; c < net->nc; ++c) {
+        if (net->cj[c] >= n) { /* a wall: never leaves the subset */
+            cnt[bid[net->ci[c]]]++;
+            continue;
+        }
         size_t a = bid[net->ci[c]], b = bid[net->cj[c]];
         if (a == b) inner[a]++;
         else {
@@ -725,6 +782,7 @@ int odhs__net_body_core(const odhs_network *cnet)
         for (size_t p = start[b]; p < start[b + 1]; ++p) {
             size_t x = beads[p];
             for (uint32_t k = 0; k < net->adjn[x]; ++k) {
+                if (net->adj[x][k] >= n) continue; /* walls */
                 size_t o = bid[net->adj[x][k]];
                 if (o == b || in[o] != 1) continue;
                 if (--cnt[o] < dof[o] + 1) {
@@ -739,7 +797,8 @@ int odhs__net_body_core(const odhs_network *cnet)
         net->bcore[i] = in[bid[i]] == 1;
         nbar += net->bcore[i];
     }
-    for (size_t c = 0; c < net->nc; ++c) ncon += net->bcore[net->ci[c]] && net->bcore[net->cj[c]];
+    for (size_t c = 0; c < net->nc; ++c)
+        ncon += net->bcore[net->ci[c]] && (net->cj[c] >= n || net->bcore[net->cj[c]]);
     net->bnbar = nbar;
     net->bncon = ncon;
     net->bc_valid = 1;
@@ -790,7 +849,9 @@ int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
         int st = odhs_network_constrained(net, &nb, &nk, NULL, NULL);
         if (st) return st;
     }
-    *flag = nb > 0 && nk >= (size_t)net->dim * (nb - 1) + 1;
+    /* isostatic: d Nbar - (global zero modes) constraints; one more is a
+     * self-stress. Without walls the zero modes are the d translations. */
+    *flag = nb > 0 && nk + net->free_modes >= (size_t)net->dim * nb + 1;
     return ODHS_OK;
 }
 
@@ -828,5 +889,90 @@ int odhs_network_get_rest_length(const odhs_network *net, const odhs_system *sys
     if (st) return st;
     if (k >= net->nc) return odhs__neterr(net, ODHS_E_RANGE, "contact index %zu >= Nc = %zu", k, net->nc);
     *rest = odhs__net_sigma(net, sys, k);
+    return ODHS_OK;
+}
+
+/* ---- walls ------------------------------------------------------------------- */
+/* Global zero modes of the particles with these walls: translations along
+ * directions no wall normal constrains, plus rigid rotations when every wall
+ * is a sphere about one centre (nothing else breaks the rotation). */
+static size_t wall_free_modes(const odhs_network *net)
+{
+    int d = net->dim;
+    double basis[3][3];
+    int rank = 0, spheres_only = 1, same_centre = 1;
+    for (size_t w = 0; w < net->nwalls; ++w) {
+        const odhs_wall *wl = &net->walls[w];
+        double cand[3][3];
+        int nc = 0;
+        if (wl->type == ODHS_WALL_SPHERE) {
+            for (int a = 0; a < d; ++a)
+                for (int b = 0; b < 3; ++b) cand[a][b] = a == b;
+            nc = d;
+            for (int k = 0; k < d; ++k) same_centre &= wl->c[k] == net->walls[0].c[k];
+        } else {
+            spheres_only = 0;
+            for (int b = 0; b < 3; ++b) cand[0][b] = wl->n[b];
+            nc = 1;
+        }
+        for (int q = 0; q < nc && rank < d; ++q) {
+            double v[3] = {cand[q][0], cand[q][1], cand[q][2]};
+            for (int r = 0; r < rank; ++r) {
+                double dot = 0.0;
+                for (int k = 0; k < 3; ++k) dot += v[k] * basis[r][k];
+                for (int k = 0; k < 3; ++k) v[k] -= dot * basis[r][k];
+            }
+            double nv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            if (nv > 1e-9) {
+                for (int k = 0; k < 3; ++k) basis[rank][k] = v[k] / nv;
+                rank++;
+            }
+        }
+    }
+    size_t modes = (size_t)(d - rank);
+    if (net->nwalls && spheres_only && same_centre) modes += d == 2 ? 1u : 3u;
+    return modes;
+}
+
+int odhs__net_add_wall(odhs_network *net, const odhs_wall *w)
+{
+    size_t nn = net->n + net->nwalls + 1; /* nodes after the addition */
+    odhs_wall *wl = odhs__realloc(net->walls, (net->nwalls + 1) * sizeof *wl);
+    if (!wl) return ODHS_E_NOMEM;
+    net->walls = wl;
+    size_t **adj = odhs__realloc(net->adj, nn * sizeof *adj);
+    if (adj) net->adj = adj;
+    uint32_t *adjn = odhs__realloc(net->adjn, nn * sizeof *adjn);
+    if (adjn) net->adjn = adjn;
+    uint32_t *adjcap = odhs__realloc(net->adjcap, nn * sizeof *adjcap);
+    if (adjcap) net->adjcap = adjcap;
+    unsigned char *core = odhs__realloc(net->core, nn);
+    if (core) net->core = core;
+    size_t *cdeg = odhs__realloc(net->cdeg, nn * sizeof *cdeg);
+    if (cdeg) net->cdeg = cdeg;
+    unsigned char *mark = odhs__realloc(net->mark, nn);
+    if (mark) net->mark = mark;
+    size_t *work = odhs__realloc(net->work, (2 * nn + 2) * sizeof *work);
+    if (work) net->work = work;
+    if (!adj || !adjn || !adjcap || !core || !cdeg || !mark || !work) return ODHS_E_NOMEM;
+    size_t node = nn - 1;
+    adj[node] = NULL;
+    adjn[node] = adjcap[node] = 0;
+    core[node] = 1; /* a wall never leaves the constrained subset */
+    cdeg[node] = 0;
+    mark[node] = 0;
+    net->walls[net->nwalls++] = *w;
+    net->free_modes = wall_free_modes(net);
+    net->version++;
+    net->topo++;
+    return ODHS_OK;
+}
+
+int odhs__net_copy_walls(odhs_network *sub, const odhs_network *net)
+{
+    for (size_t w = sub->nwalls; w < net->nwalls; ++w) {
+        int st = odhs__net_add_wall(sub, &net->walls[w]);
+        if (st) return st;
+    }
     return ODHS_OK;
 }

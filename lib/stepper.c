@@ -151,6 +151,18 @@ static int compute_forces(odhs_stepper *st)
     double *b = st->cb;
     for (size_t c = 0; c < nc; ++c) {
         const double *n = net->nrm + c * dim;
+        if (net->nwalls && net->cj[c] >= st->n) {
+            /* wall: (S V_aff)_c + w_c = n.(v_wall - G0 x_i), S F = -n.F_i */
+            const odhs_wall *w = &net->walls[net->cj[c] - st->n];
+            const double *xi = st->sys->x + net->ci[c] * dim;
+            double gx[3], v = 0.0;
+            apply_G(G0, dim, xi, gx);
+            for (int k = 0; k < dim; ++k) v += (w->v[k] - gx[k]) * n[k];
+            if (st->has_F)
+                for (int k = 0; k < dim; ++k) v -= xi0 * st->F[net->ci[c] * dim + k] * n[k];
+            b[c] = -v / xi0;
+            continue;
+        }
         double d[3] = {0, 0, 0}, gd[3];
         for (int k = 0; k < dim; ++k) d[k] = n[k] * net->dist[c];
         apply_G(G0, dim, d, gd);
@@ -200,6 +212,8 @@ static double velocity_scale(const odhs_stepper *st)
 {
     double umax = 0.0, g = 0.0;
     for (size_t k = 0; k < st->nd; ++k) umax = fmax(umax, fabs(st->U[k]));
+    for (size_t w = 0; w < st->net->nwalls; ++w)
+        for (int k = 0; k < st->dim; ++k) umax = fmax(umax, fabs(st->net->walls[w].v[k]));
     for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) g += st->G[3 * (a) + (b)] * st->G[3 * (a) + (b)];
     return umax + sqrt(g) * 2.0 * st->sys->rmax;
@@ -210,6 +224,14 @@ static double pair_velocity(const odhs_stepper *st, size_t i, size_t j)
 {
     int dim = st->dim;
     double d[3], gd[3];
+    if (j >= st->n) { /* a wall: rate of the gap, n.(v_wall - V_i) */
+        const odhs_wall *w = &st->net->walls[j - st->n];
+        double nrm[3], gx[3], v = 0.0;
+        odhs__wall_geom(w, dim, st->sys->x + i * dim, nrm);
+        apply_G(st->G, dim, st->sys->x + i * dim, gx);
+        for (int k = 0; k < dim; ++k) v += nrm[k] * (w->v[k] - gx[k] - st->U[i * dim + k]);
+        return v;
+    }
     min_sep(st, i, j, d);
     apply_G(st->G, dim, d, gd);
     double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), v = 0.0;
@@ -221,6 +243,14 @@ static void contact_geometry(odhs_stepper *st, size_t c)
 {
     odhs_network *net = st->net;
     int dim = st->dim;
+    if (net->cj[c] >= st->n) {
+        size_t i = net->ci[c];
+        double r = odhs__wall_geom(&net->walls[net->cj[c] - st->n], dim, st->sys->x + i * dim, net->nrm + c * dim);
+        net->dist[c] = r;
+        net->gap[c] = r - st->sys->r[i];
+        net->version++;
+        return;
+    }
     double d[3];
     min_sep(st, net->ci[c], net->cj[c], d);
     double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -256,7 +286,7 @@ static int rewire(odhs_stepper *st)
         size_t kmin = SIZE_MAX;
         for (size_t c = 0; c < net->nc; ++c) {
             fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
-            if (net->kind[c] == ODHS_CONTACT_TEMPORARY && net->f[c] < fmin) {
+            if (odhs__can_open(net->kind[c]) && net->f[c] < fmin) {
                 fmin = net->f[c];
                 kmin = c;
             }
@@ -406,11 +436,14 @@ static double skin_rate(const odhs_stepper *st, const double *G, const double *v
     return 2.0 * sqrt(umax) + frob(G) * frob(st->M) * st->rc;
 }
 
+static double predict_walls(const odhs_stepper *st, const double *G, const double *vel, double best, double vtol,
+                            int moving, size_t *pi, size_t *pj);
+
 /* ---- collision prediction ------------------------------------------------ */
 /* earliest time in [0, horizon] at which a non-contact pair touches when
  * separations move as d + t (G d + vel_j - vel_i) */
 static double predict(const odhs_stepper *st, const double *G, const double *vel, double horizon,
-                      double vtol, size_t *pi, size_t *pj)
+                      double vtol, int moving, size_t *pi, size_t *pj)
 {
     const odhs_system *s = st->sys;
     int dim = st->dim;
@@ -451,10 +484,104 @@ static double predict(const odhs_stepper *st, const double *G, const double *vel
             *pj = j;
         }
     }
+    if (st->net->nwalls) best = predict_walls(st, G, vel, best, vtol, moving, pi, pj);
     return best;
 }
 
-/* move by t along (G, vel), deforming the box with G */
+/* earliest time in [0, best) at which a particle not in contact with a wall
+ * touches it, moving as x + t (G x + vel) against walls translating with their
+ * velocities (moving = 1) or at rest (moving = 0, the drift correction) */
+static double predict_walls(const odhs_stepper *st, const double *G, const double *vel, double best, double vtol,
+                            int moving, size_t *pi, size_t *pj)
+{
+    const odhs_system *s = st->sys;
+    const odhs_network *net = st->net;
+    int dim = st->dim;
+    ((odhs_network *)net)->work_walls++;
+    for (size_t w = 0; w < net->nwalls; ++w) {
+        const odhs_wall *wl = &net->walls[w];
+        for (size_t i = 0; i < st->n; ++i) {
+            const double *x = s->x + i * dim;
+            double a = s->r[i], u[3] = {0, 0, 0}, nrm[3] = {0, 0, 0}, gx[3];
+            apply_G(G, dim, x, gx);
+            for (int k = 0; k < dim; ++k) u[k] = gx[k] + vel[i * dim + k] - (moving ? wl->v[k] : 0.0);
+            double g0 = odhs__wall_geom(wl, dim, x, nrm) - a, un = 0.0, uu = 0.0;
+            for (int k = 0; k < dim; ++k) {
+                un += nrm[k] * u[k]; /* > 0: approaching */
+                uu += u[k] * u[k];
+            }
+            if (un <= 0.0 && wl->type == ODHS_WALL_PLANE) continue; /* moving away for good */
+            if (g0 > 0.0 && g0 > best * sqrt(uu)) continue; /* cannot reach it in time */
+            if (odhs__net_find(net, i, st->n + w) != SIZE_MAX) continue;
+            double t = INFINITY;
+            if (g0 <= 0.0) {
+                if (un > vtol) t = 0.0; /* touching (round-off) and approaching */
+            } else if (wl->type == ODHS_WALL_PLANE) {
+                t = g0 / un;
+            } else if (wl->type == ODHS_WALL_SPHERE) {
+                /* |q + t u| = R - a from inside: the positive root */
+                double q[3] = {0, 0, 0}, B = 0.0, C = 0.0, Rm = wl->R - a;
+                for (int k = 0; k < dim; ++k) {
+                    q[k] = x[k] - wl->c[k];
+                    B += q[k] * u[k];
+                    C += q[k] * q[k];
+                }
+                C -= Rm * Rm; /* < 0 inside */
+                if (uu > 0.0) t = (-C) / (B + sqrt(B * B - uu * C));
+            } else {
+                /* segment: its sides, then its two ends */
+                double e[3] = {0, 0, 0}, L2 = 0.0, q[3] = {0, 0, 0};
+                for (int k = 0; k < dim; ++k) {
+                    e[k] = wl->b[k] - wl->c[k];
+                    L2 += e[k] * e[k];
+                    q[k] = x[k] - wl->c[k];
+                }
+                double m0 = -e[1], m1 = e[0], Ls = sqrt(L2);
+                double sd = (m0 * q[0] + m1 * q[1]) / Ls, su = (m0 * u[0] + m1 * u[1]) / Ls;
+                double sg = sd >= 0.0 ? 1.0 : -1.0;
+                if (sg * sd > a && sg * su < 0.0) {
+                    double t1 = (sg * sd - a) / (-sg * su);
+                    double p = ((q[0] + t1 * u[0]) * e[0] + (q[1] + t1 * u[1]) * e[1]) / L2;
+                    if (p >= 0.0 && p <= 1.0) t = t1;
+                }
+                const double *ends[2] = {wl->c, wl->b};
+                for (int k2 = 0; k2 < 2; ++k2) {
+                    double qe[2] = {x[0] - ends[k2][0], x[1] - ends[k2][1]};
+                    double B = qe[0] * u[0] + qe[1] * u[1], C = qe[0] * qe[0] + qe[1] * qe[1] - a * a;
+                    if (B >= 0.0 || C <= 0.0) continue;
+                    double disc = B * B - uu * C;
+                    if (disc < 0.0) continue;
+                    t = fmin(t, C / (-B + sqrt(disc)));
+                }
+            }
+            if (t < best) {
+                best = t;
+                *pi = i;
+                *pj = st->n + w;
+            }
+        }
+    }
+    return best;
+}
+
+/* move by t along (G, vel), deforming the box with G; walls translate with
+ * their velocities when moving != 0 */
+static void advance_walls(odhs_stepper *st, double t)
+{
+    for (size_t w = 0; w < st->net->nwalls; ++w) {
+        odhs_wall *wl = &st->net->walls[w];
+        double vn = 0.0;
+        for (int k = 0; k < st->dim; ++k) {
+            double dx = t * wl->v[k];
+            wl->c[k] += dx;
+            wl->b[k] += dx;
+            wl->disp[k] += dx;
+            vn += wl->n[k] * wl->v[k];
+        }
+        if (wl->type == ODHS_WALL_PLANE) wl->h += t * vn;
+    }
+}
+
 static void advance(odhs_stepper *st, const double *G, const double *vel, double t)
 {
     odhs_system *s = st->sys;
@@ -504,6 +631,15 @@ static int snapshot(odhs_stepper *st)
         if (!a || !b || !k || !f || !rs) return sterr(st, ODHS_E_NOMEM, "out of memory");
         st->scap = cap;
     }
+    if (net->nwalls) {
+        if (st->wsnapcap < net->nwalls) {
+            odhs_wall *w = odhs__realloc(st->wsnap, net->nwalls * sizeof *w);
+            if (!w) return sterr(st, ODHS_E_NOMEM, "out of memory");
+            st->wsnap = w;
+            st->wsnapcap = net->nwalls;
+        }
+        memcpy(st->wsnap, net->walls, net->nwalls * sizeof *net->walls);
+    }
     memcpy(st->xs, st->sys->x, st->nd * sizeof *st->xs);
     memcpy(st->Ls, st->sys->L, sizeof st->Ls);
     st->gammas = st->sys->gamma;
@@ -530,6 +666,7 @@ static void rollback(odhs_stepper *st)
 {
     odhs_network *net = st->net;
     memcpy(st->sys->x, st->xs, st->nd * sizeof *st->xs);
+    if (net->nwalls) memcpy(net->walls, st->wsnap, net->nwalls * sizeof *net->walls);
     memcpy(st->sys->L, st->Ls, sizeof st->Ls);
     st->sys->gamma = st->gammas;
     st->time = st->times;
@@ -593,7 +730,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
     if (!st) return;
     odhs_network_destroy(st->net);
     void *arrays[] = {st->disps, st->U0, st->Ua, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
-                      st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->srest, st->ev};
+                      st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->srest, st->ev, st->wsnap};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
 }
@@ -666,6 +803,8 @@ static int check_driver(odhs_stepper *st)
     odhs_driver *d = st->drv;
     if (d->pressure_on && d->gdot == 0.0)
         return sterr(st, ODHS_E_UNSUPPORTED, "fixed pressure needs a nonzero shear rate");
+    if (d->pressure_on && st->net->nwalls)
+        return sterr(st, ODHS_E_UNSUPPORTED, "fixed pressure with walls is not supported");
     if (d->pressure_on && d->crate != 0.0)
         return sterr(st, ODHS_E_UNSUPPORTED, "fixed pressure and a compression rate cannot be combined");
     if (d->F && (d->Fn != st->n || d->Fdim != st->dim))
@@ -693,8 +832,8 @@ int odhs_stepper_reset(odhs_stepper *st)
     if ((s = snapshot(st))) return s;
     odhs__net_geometry(net, st->sys);
     for (size_t c = net->nc; c-- > 0;) {
-        double sig = st->sys->r[net->ci[c]] + st->sys->r[net->cj[c]];
-        if (net->kind[c] == ODHS_CONTACT_TEMPORARY &&
+        double sig = odhs__net_sigma(net, st->sys, c);
+        if (odhs__can_open(net->kind[c]) &&
             (fabs(net->gap[c]) > fmax(1e-6, st->contact_tol) * sig || odhs__same_body(net, net->ci[c], net->cj[c])))
             odhs__net_remove_at(net, c);
     }
@@ -746,7 +885,7 @@ static int correct(odhs_stepper *st, int *added)
         odhs__net_ST(net, st->cx, st->tmp);
         for (size_t k = 0; k < st->nd; ++k) st->tmp[k] = -st->tmp[k];
         size_t pi, pj;
-        double t = predict(st, Z, st->tmp, 1.0, 0.0, &pi, &pj);
+        double t = predict(st, Z, st->tmp, 1.0, 0.0, 0, &pi, &pj);
         advance(st, Z, st->tmp, t);
         if (pi != SIZE_MAX) {
             size_t c = odhs__net_add(net, pi, pj, ODHS_CONTACT_TEMPORARY);
@@ -802,6 +941,7 @@ static int restart_step(odhs_stepper *st)
 {
     odhs_network *net = st->net;
     memcpy(st->sys->x, st->xs, st->nd * sizeof *st->xs);
+    if (net->nwalls) memcpy(net->walls, st->wsnap, net->nwalls * sizeof *net->walls);
     memcpy(st->sys->L, st->Ls, sizeof st->Ls);
     st->sys->gamma = st->gammas;
     st->time = st->times;
@@ -844,6 +984,7 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         memcpy(disp0, st->disp, nd * sizeof *disp0);
         double t0 = st->time;
         advance(st, G0, st->U0, tau);
+        if (net->nwalls) advance_walls(st, tau);
         st->time = t0 + tau;
         odhs__net_geometry(net, sys);
         s = eval_forces(st);
@@ -867,6 +1008,7 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         memcpy(Gs, st->G, sizeof Gs);
         /* restore the start of the step (forces in net->f stay as a guess) */
         memcpy(sys->x, st->xs, nd * sizeof *sys->x);
+        if (net->nwalls) memcpy(net->walls, st->wsnap, net->nwalls * sizeof *net->walls);
         memcpy(sys->L, st->Ls, sizeof st->Ls);
         sys->gamma = st->gammas;
         memcpy(st->M, M0, sizeof M0);
@@ -962,8 +1104,9 @@ again:;
         if (rate * tplan > 0.9 * st->skin) tplan = 0.9 * st->skin / rate;
     }
     size_t ci, cj;
-    double t = predict(st, G, vel, tplan, EPS_V * velocity_scale(st), &ci, &cj);
+    double t = predict(st, G, vel, tplan, EPS_V * velocity_scale(st), 1, &ci, &cj);
     advance(st, G, vel, t);
+    if (st->net->nwalls) advance_walls(st, t);
     for (size_t k = 0; k < st->nd; ++k)
         if (!isfinite(st->sys->x[k])) {
             s = sterr(st, ODHS_E_NONFINITE, "non-finite positions after a step of %g (rates too large?)", t);
@@ -1005,7 +1148,7 @@ again:;
             for (size_t c = 0; c < net->nc; ++c) fbig = fmax(fbig, fabs(net->f[c]));
             for (size_t c = 0; c < net->nc; ++c) {
                 double f0 = st->sf[c], f1 = net->f[c];
-                if (net->kind[c] != ODHS_CONTACT_TEMPORARY || !(f1 < -EPS_F * fbig) || !(f0 > 0.0)) continue;
+                if (!odhs__can_open(net->kind[c]) || !(f1 < -EPS_F * fbig) || !(f0 > 0.0)) continue;
                 tstar = fmin(tstar, t * f0 / (f0 - f1));
             }
             if (tstar < 0.999 * t) {
@@ -1207,6 +1350,7 @@ int odhs_stepper_stress(const odhs_stepper *st, double *sigma)
     odhs_system_volume(st->sys, &vol);
     for (int a = 0; a < dim * dim; ++a) sigma[a] = 0.0;
     for (size_t c = 0; c < net->nc; ++c) {
+        if (net->cj[c] >= st->n) continue; /* walls: see odhs_stepper_wall_force */
         const double *n = net->nrm + c * dim;
         double w = net->f[c] * net->dist[c];
         for (int a = 0; a < dim; ++a)
@@ -1234,7 +1378,8 @@ int odhs_stepper_pressure(const odhs_stepper *st, double *p)
     const odhs_network *net = st->net;
     double vol, fr = 0.0;
     odhs_system_volume(st->sys, &vol);
-    for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
+    for (size_t c = 0; c < net->nc; ++c)
+        if (net->cj[c] < st->n) fr += net->f[c] * net->dist[c];
     *p = fr / (vol * st->dim);
     return ODHS_OK;
 }
@@ -1267,10 +1412,18 @@ int odhs_stepper_power(const odhs_stepper *st, double *P)
     double p = 0.0;
     for (size_t c = 0; c < net->nc; ++c) {
         const double *n = net->nrm + c * dim;
+        double v = 0.0;
+        if (net->cj[c] >= st->n) { /* wall: (S V_aff)_c + w_c = n.(v_wall - G x_i) */
+            const odhs_wall *w = &net->walls[net->cj[c] - st->n];
+            double gx[3];
+            apply_G(st->G, dim, st->sys->x + net->ci[c] * dim, gx);
+            for (int k = 0; k < dim; ++k) v += (w->v[k] - gx[k]) * n[k];
+            p -= net->f[c] * v;
+            continue;
+        }
         double d[3] = {0, 0, 0}, gd[3];
         for (int k = 0; k < dim; ++k) d[k] = n[k] * net->dist[c];
         apply_G(st->G, dim, d, gd);
-        double v = 0.0;
         for (int k = 0; k < dim; ++k) v += gd[k] * n[k];
         p -= net->f[c] * v;
     }
@@ -1317,6 +1470,7 @@ int odhs_stepper_feature_work(const odhs_stepper *st, int feature, uint64_t *cou
     switch (feature) {
     case ODHS_FEATURE_PRESSURE: *count = st->work_pressure; return ODHS_OK;
     case ODHS_FEATURE_COMPOSITE: *count = st->net->work_composite; return ODHS_OK;
+    case ODHS_FEATURE_WALLS: *count = st->net->work_walls; return ODHS_OK;
     default: return sterr(st, ODHS_E_INVALID, "unknown feature %d", feature);
     }
 }
@@ -1357,6 +1511,12 @@ int odhs_stepper_errors(const odhs_stepper *st, double *contact_gap, double *ove
         ov_ctx c = {s->r, -INFINITY, net};
         int r = odhs__pairs(s->dim, s->n, s->x, s->r, s->rmax, s->L, s->gamma, 0.0, ov_cb, &c);
         if (r == ODHS_E_NOMEM) return sterr(st, r, "out of memory");
+        for (size_t w = 0; w < net->nwalls; ++w)
+            for (size_t i = 0; i < s->n; ++i) {
+                double nrm[3];
+                double g = odhs__wall_geom(&net->walls[w], s->dim, s->x + i * s->dim, nrm) - s->r[i];
+                c.worst = fmax(c.worst, -g / s->r[i]);
+            }
         *overlap = c.worst > 0.0 ? c.worst : 0.0;
     }
     return ODHS_OK;

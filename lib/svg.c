@@ -97,10 +97,22 @@ int odhs_svg_write(const odhs_system *sys, const odhs_network *net, const unsign
     if (net && net->nc) {
         double fmax = 0.0;
         for (size_t c = 0; c < net->nc; ++c)
-            if (net->kind[c] == ODHS_CONTACT_TEMPORARY) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
+            if (odhs__can_open(net->kind[c])) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
         double wmax = 0.3 * v.s * sys->rmax;
         for (size_t c = 0; c < net->nc && ok; ++c) {
             size_t i = net->ci[c], j = net->cj[c];
+            if (j >= n) {
+                /* wall contact: from the centre to the contact point */
+                const double *a = sys->x + i * d, *nr = net->nrm + c * d;
+                double w = fmax > 0.0 ? wmax * fabs(net->f[c]) / fmax : 1.0;
+                if (w < 0.4) w = 0.4;
+                ok &= fprintf(f,
+                              "<line x1=\"%.3f\" y1=\"%.3f\" x2=\"%.3f\" y2=\"%.3f\" stroke=\"#000000\" "
+                              "stroke-width=\"%.2f\" stroke-linecap=\"round\"/>\n",
+                              px(&v, a[0]), py(&v, a[1]), px(&v, a[0] + net->dist[c] * nr[0]),
+                              py(&v, a[1] + net->dist[c] * nr[1]), w) > 0;
+                continue;
+            }
             double dv[3] = {0, 0, 0};
             for (int a = 0; a < d; ++a) dv[a] = sys->x[j * d + a] - sys->x[i * d + a];
             odhs__min_image(d, sys->L, g, dv, NULL);
@@ -130,6 +142,23 @@ int odhs_svg_write(const odhs_system *sys, const odhs_network *net, const unsign
                                       py(&v, Y + 0.5 * sgn * dv[1]), col, w, dash) > 0;
                     }
             }
+        }
+    }
+    /* walls (3D: planes seen edge-on and spheres, projected on x-y) */
+    for (size_t w = 0; net && w < net->nwalls && ok; ++w) {
+        const odhs_wall *wl = &net->walls[w];
+        const char *st = "stroke=\"#4d4d4d\" stroke-width=\"4\" stroke-linecap=\"round\" fill=\"none\"";
+        if (wl->type == ODHS_WALL_SPHERE) {
+            ok &= fprintf(f, "<circle cx=\"%.3f\" cy=\"%.3f\" r=\"%.3f\" %s/>\n", px(&v, wl->c[0]), py(&v, wl->c[1]),
+                          v.s * wl->R, st) > 0;
+        } else if (wl->type == ODHS_WALL_SEGMENT) {
+            ok &= fprintf(f, "<line x1=\"%.3f\" y1=\"%.3f\" x2=\"%.3f\" y2=\"%.3f\" %s/>\n", px(&v, wl->c[0]),
+                          py(&v, wl->c[1]), px(&v, wl->b[0]), py(&v, wl->b[1]), st) > 0;
+        } else if (d == 2 || fabs(wl->n[2]) < 1e-12) {
+            double big = 4.0 * (Lx + Ly), o[2] = {wl->h * wl->n[0], wl->h * wl->n[1]}, t[2] = {-wl->n[1], wl->n[0]};
+            ok &= fprintf(f, "<line x1=\"%.3f\" y1=\"%.3f\" x2=\"%.3f\" y2=\"%.3f\" %s/>\n",
+                          px(&v, o[0] - big * t[0]), py(&v, o[1] - big * t[1]), px(&v, o[0] + big * t[0]),
+                          py(&v, o[1] + big * t[1]), st) > 0;
         }
     }
     ok &= fprintf(f, "</g>\n<polygon points=\"") > 0;

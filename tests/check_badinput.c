@@ -1559,6 +1559,52 @@ static int huge_rate_case(void)
       return odhs_stepper_feature_work(w->run, ODHS_FEATURE_PRESSURE, NULL);)                                  \
     X(st_feature_unknown, odhs_stepper_feature_work, ODHS_E_INVALID, NOALT, H_RUN, 0,                          \
       uint64_t c; return odhs_stepper_feature_work(w->run, 0, &c);)                                            \
+    X(st_wplane_null, odhs_stepper_add_wall_plane, ODHS_E_NULL, NOALT, H_NONE, 0,                              \
+      double nv[2] = {0, 1}; return odhs_stepper_add_wall_plane(NULL, nv, 0.0, NULL);)                         \
+    X(st_wplane_null_normal, odhs_stepper_add_wall_plane, ODHS_E_NULL, NOALT, H_RUN, 0,                        \
+      return odhs_stepper_add_wall_plane(w->run, NULL, 0.0, NULL);)                                            \
+    X(st_wplane_zero, odhs_stepper_add_wall_plane, ODHS_E_INVALID, NOALT, H_RUN, 0,                            \
+      double nv[2] = {0, 0}; return odhs_stepper_add_wall_plane(w->run, nv, 0.0, NULL);)                       \
+    X(st_wplane_nan, odhs_stepper_add_wall_plane, ODHS_E_NONFINITE, NOALT, H_RUN, 0,                           \
+      double nv[2] = {0, 1}; return odhs_stepper_add_wall_plane(w->run, nv, NAN_, NULL);)                      \
+    X(st_wplane_overlap, odhs_stepper_add_wall_plane, ODHS_E_OVERLAP, NOALT, H_RUN, 0,                         \
+      double nv[2] = {0, 1}; return odhs_stepper_add_wall_plane(w->run, nv, 1e6, NULL);)                       \
+    X(st_wsphere_null, odhs_stepper_add_wall_sphere, ODHS_E_NULL, NOALT, H_NONE, 0,                            \
+      double c[2] = {0, 0}; return odhs_stepper_add_wall_sphere(NULL, c, 1.0, NULL);)                          \
+    X(st_wsphere_null_centre, odhs_stepper_add_wall_sphere, ODHS_E_NULL, NOALT, H_RUN, 0,                      \
+      return odhs_stepper_add_wall_sphere(w->run, NULL, 1.0, NULL);)                                           \
+    X(st_wsphere_radius, odhs_stepper_add_wall_sphere, ODHS_E_INVALID, NOALT, H_RUN, 0,                        \
+      double c[2] = {0, 0}; return odhs_stepper_add_wall_sphere(w->run, c, 0.0, NULL);)                        \
+    X(st_wsphere_inf, odhs_stepper_add_wall_sphere, ODHS_E_NONFINITE, NOALT, H_RUN, 0,                         \
+      double c[2] = {0, INF_}; return odhs_stepper_add_wall_sphere(w->run, c, 1.0, NULL);)                     \
+    X(st_wsphere_overlap, odhs_stepper_add_wall_sphere, ODHS_E_OVERLAP, NOALT, H_RUN, 0,                       \
+      double c[2] = {-1e3, -1e3}; return odhs_stepper_add_wall_sphere(w->run, c, 1.0, NULL);)                  \
+    X(st_wseg_null, odhs_stepper_add_wall_segment, ODHS_E_NULL, NOALT, H_NONE, 0,                              \
+      double a[2] = {0, 0}, b[2] = {1, 0}; return odhs_stepper_add_wall_segment(NULL, a, b, NULL);)            \
+    X(st_wseg_null_end, odhs_stepper_add_wall_segment, ODHS_E_NULL, NOALT, H_RUN, 0,                           \
+      double a[2] = {0, 0}; return odhs_stepper_add_wall_segment(w->run, a, NULL, NULL);)                      \
+    X(st_wseg_degenerate, odhs_stepper_add_wall_segment, ODHS_E_INVALID, NOALT, H_RUN, 0,                      \
+      double a[2] = {-5, -5}; return odhs_stepper_add_wall_segment(w->run, a, a, NULL);)                       \
+    X(st_wseg_nan, odhs_stepper_add_wall_segment, ODHS_E_NONFINITE, NOALT, H_RUN, 0,                           \
+      double a[2] = {0, NAN_}, b[2] = {1, 0}; return odhs_stepper_add_wall_segment(w->run, a, b, NULL);)       \
+    X(st_wvel_null, odhs_stepper_set_wall_velocity, ODHS_E_NULL, NOALT, H_NONE, 0,                             \
+      double v[2] = {0, 0}; return odhs_stepper_set_wall_velocity(NULL, 0, v);)                                \
+    X(st_wvel_range, odhs_stepper_set_wall_velocity, ODHS_E_RANGE, NOALT, H_RUN, 0,                            \
+      double v[2] = {0, 0}; return odhs_stepper_set_wall_velocity(w->run, 0, v);)                              \
+    X(st_wcount_null, odhs_stepper_wall_count, ODHS_E_NULL, NOALT, H_NONE, 0,                                  \
+      size_t c; return odhs_stepper_wall_count(NULL, &c);)                                                     \
+    X(st_wcount_null_out, odhs_stepper_wall_count, ODHS_E_NULL, NOALT, H_RUN, 0,                               \
+      return odhs_stepper_wall_count(w->run, NULL);)                                                           \
+    X(st_wforce_null, odhs_stepper_wall_force, ODHS_E_NULL, NOALT, H_NONE, 0,                                  \
+      double f[2]; return odhs_stepper_wall_force(NULL, 0, f);)                                                \
+    X(st_wforce_range, odhs_stepper_wall_force, ODHS_E_RANGE, NOALT, H_RUN, 0,                                 \
+      double f[2]; return odhs_stepper_wall_force(w->run, 3, f);)                                              \
+    X(st_wforce_null_out, odhs_stepper_wall_force, ODHS_E_NULL, NOALT, H_RUN, 0,                               \
+      return odhs_stepper_wall_force(w->run, 0, NULL);)                                                        \
+    X(st_wdisp_null, odhs_stepper_wall_displacement, ODHS_E_NULL, NOALT, H_NONE, 0,                            \
+      double f[2]; return odhs_stepper_wall_displacement(NULL, 0, f);)                                         \
+    X(st_wdisp_range, odhs_stepper_wall_displacement, ODHS_E_RANGE, NOALT, H_RUN, 0,                           \
+      double f[2]; return odhs_stepper_wall_displacement(w->run, 0, f);)                                       \
     X(st_bondcount_null, odhs_stepper_bond_count, ODHS_E_NULL, NOALT, H_NONE, 0,                               \
       size_t c; return odhs_stepper_bond_count(NULL, &c);)                                                     \
     X(st_bondcount_null_out, odhs_stepper_bond_count, ODHS_E_NULL, NOALT, H_RUN, 0,                            \

@@ -54,7 +54,8 @@ ODHS_API int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certifica
  * '#' (N, dim, Nc and the column names), then one line per contact
  * "i j s0 s1 [s2] force gap" with the lattice image shift s such that the
  * contact vector is R_ij = x_j - x_i + s0 a + s1 b + s2 c (system.h), the
- * force and the gap, numbers with 17 significant digits. Written atomically
+ * force and the gap, numbers with 17 significant digits (a contact with wall w
+ * is "i N+w 0 0 [0] force gap"). Written atomically
  * (temporary file, then rename). Errors: ODHS_E_NULL, ODHS_E_DIM (system and
  * network differ), ODHS_E_IO.
  */

@@ -12,6 +12,11 @@
  * negative; ODHS_CONTACT_PERMANENT contacts (bonds of composite particles)
  * never open and may carry negative force.
  *
+ * ODHS_CONTACT_WALL contacts join particle i to hard wall w and are reported as
+ * the pair (i, N + w); their row of S holds -n_c on particle i's block only,
+ * with n_c the unit normal from the particle towards the wall; they open like
+ * temporary contacts.
+ *
  * Contact indices (0..Nc-1) are positions in the current list and change when
  * contacts are added or removed; pairs (i,j) are the stable identities.
  */
@@ -28,7 +33,8 @@ typedef struct odhs_network odhs_network;
 
 enum {
     ODHS_CONTACT_TEMPORARY = 0,
-    ODHS_CONTACT_PERMANENT = 1
+    ODHS_CONTACT_PERMANENT = 1,
+    ODHS_CONTACT_WALL = 2 /* particle i against wall j - N (see walls.h) */
 };
 
 /** Create an empty network for the particles of sys (the network remembers N

@@ -178,7 +178,8 @@ ODHS_API int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejec
 ODHS_API int odhs_stepper_counts(const odhs_stepper *st, uint64_t *steps, uint64_t *collisions,
                                  uint64_t *openings);
 /** Stress tensor sigma_ab = -(1/Omega) sum_c f_c R_a R_b / r (dim*dim, row-major;
- *  eq. 30 generalised, positive shear stress sigma_xy under positive shear). */
+ *  eq. 30 generalised, positive shear stress sigma_xy under positive shear),
+ *  over particle contacts and bonds (wall forces: odhs_stepper_wall_force). */
 ODHS_API int odhs_stepper_stress(const odhs_stepper *st, double *sigma);
 /** Shear stress sigma_xy. */
 ODHS_API int odhs_stepper_shear_stress(const odhs_stepper *st, double *sigma_xy);
@@ -201,16 +202,18 @@ ODHS_API int odhs_stepper_coordination(const odhs_stepper *st, double *z);
  *  values; more may be added). */
 enum {
     ODHS_FEATURE_PRESSURE = 1,  /* pressure control: the extra solve for kappa  */
-    ODHS_FEATURE_COMPOSITE = 2  /* bonds: rest lengths, body-level subset       */
+    ODHS_FEATURE_COMPOSITE = 2, /* bonds: rest lengths, body-level subset       */
+    ODHS_FEATURE_WALLS = 3      /* walls: collision prediction against walls    */
 };
 /** How many times the stepper ran the code of an optional feature: passes of
- *  the pressure-control solve, or passes over bond rest lengths and rebuilds
- *  of the body-level constrained subset. A scene that does not use a feature
+ *  the pressure-control solve, passes over bond rest lengths and rebuilds of
+ *  the body-level constrained subset, or wall collision predictions. A scene that does not use a feature
  *  reads 0: it pays nothing for it. ODHS_E_INVALID for an unknown feature. */
 ODHS_API int odhs_stepper_feature_work(const odhs_stepper *st, int feature, uint64_t *count);
 /** The current contact network (owned by the stepper; read only). */
 ODHS_API const odhs_network *odhs_stepper_network(const odhs_stepper *st);
-/** Largest |gap|/(a_i+a_j) over contacts and the largest overlap
+/** Largest |gap|/(a_i+a_j) over contacts (|gap|/a_i for wall contacts, the
+ *  rest length for bonds) and the largest overlap (walls included)
  *  -gap/(a_i+a_j) over all pairs (<= 0 if none); either may be NULL. */
 ODHS_API int odhs_stepper_errors(const odhs_stepper *st, double *contact_gap, double *overlap);
 

@@ -168,7 +168,7 @@ static void fill_S(const odhs_network *net, size_t nextra, cholmod_sparse *A, si
     memset(cnt, 0, n * sizeof *cnt);
     for (size_t c = 0; c < nc; ++c) {
         cnt[net->ci[c]]++;
-        cnt[net->cj[c]]++;
+        if (net->cj[c] < n) cnt[net->cj[c]]++; /* a wall has no block */
     }
     Ap[0] = 0;
     for (size_t p = 0; p < n; ++p)
@@ -176,12 +176,17 @@ static void fill_S(const odhs_network *net, size_t nextra, cholmod_sparse *A, si
     memset(cnt, 0, n * sizeof *cnt);
     for (size_t c = 0; c < nc; ++c) {
         size_t i = net->ci[c], j = net->cj[c];
-        size_t oi = cnt[i]++, oj = cnt[j]++;
+        size_t oi = cnt[i]++;
         const double *nr = net->nrm + c * d;
         for (int k = 0; k < d; ++k) {
-            size_t qi = (size_t)Ap[i * d + k] + oi, qj = (size_t)Ap[j * d + k] + oj;
+            size_t qi = (size_t)Ap[i * d + k] + oi;
             Ai[qi] = (int)c;
             Ax[qi] = -nr[k];
+        }
+        if (j >= n) continue;
+        size_t oj = cnt[j]++;
+        for (int k = 0; k < d; ++k) {
+            size_t qj = (size_t)Ap[j * d + k] + oj;
             Ai[qj] = (int)c;
             Ax[qj] = nr[k];
         }
@@ -612,12 +617,12 @@ static int pcg_incidence(pcg_state *s, const odhs_network *net)
     memset(start, 0, (n + 1) * sizeof *start);
     for (size_t c = 0; c < nc; ++c) {
         start[net->ci[c] + 1]++;
-        start[net->cj[c] + 1]++;
+        if (net->cj[c] < n) start[net->cj[c] + 1]++;
     }
     for (size_t p = 0; p < n; ++p) start[p + 1] += start[p];
     for (size_t c = 0; c < nc; ++c) {
         inc[start[net->ci[c]]++] = c;
-        inc[start[net->cj[c]]++] = c;
+        if (net->cj[c] < n) inc[start[net->cj[c]]++] = c;
     }
     for (size_t p = n; p > 0; --p) start[p] = start[p - 1];
     start[0] = 0;
@@ -640,6 +645,7 @@ static int pcg_rowadd(pcg_state *s, const odhs_network *net, size_t c, size_t t)
     size_t ends[2] = {net->ci[c], net->cj[c]};
     for (int e = 0; e < 2; ++e) {
         size_t p = ends[e];
+        if (p >= net->n) continue; /* a wall */
         double sc = p == net->ci[c] ? -1.0 : 1.0;
         for (size_t u = s->start[p]; u < s->start[p + 1]; ++u) {
             size_t c2 = s->inc[u];

@@ -72,12 +72,12 @@ static int dense_setup(void *state, const odhs_network *net)
     memset(s->start, 0, (n + 1) * sizeof *s->start);
     for (size_t c = 0; c < nc; ++c) {
         s->start[net->ci[c] + 1]++;
-        s->start[net->cj[c] + 1]++;
+        if (net->cj[c] < n) s->start[net->cj[c] + 1]++; /* a wall has no block */
     }
     for (size_t i = 0; i < n; ++i) s->start[i + 1] += s->start[i];
     for (size_t c = 0; c < nc; ++c) {
         s->inc[s->start[net->ci[c]]++] = c;
-        s->inc[s->start[net->cj[c]]++] = c;
+        if (net->cj[c] < n) s->inc[s->start[net->cj[c]]++] = c;
     }
     for (size_t i = n; i > 0; --i) s->start[i] = s->start[i - 1];
     s->start[0] = 0;

@@ -175,17 +175,21 @@ static int analyse(spqr_state *s, const odhs_network *net)
     if (!s->A) return cc_status(s);
     SuiteSparse_long *Ap = s->A->p, *Ai = s->A->i;
     double *Ax = s->A->x;
+    size_t p = 0;
     for (size_t c = 0; c < nc; ++c) {
         size_t i = net->ci[c], j = net->cj[c]; /* i < j: rows come out sorted */
-        size_t p = 2 * d * c;
         Ap[c] = (SuiteSparse_long)p;
         for (size_t k = 0; k < d; ++k) {
-            Ai[p + k] = (SuiteSparse_long)(i * d + k);
-            Ai[p + d + k] = (SuiteSparse_long)(j * d + k);
-            Ax[p + k] = Ax[p + d + k] = 0.0;
+            Ai[p] = (SuiteSparse_long)(i * d + k);
+            Ax[p++] = 0.0;
+        }
+        if (j >= net->n) continue; /* a wall has no block */
+        for (size_t k = 0; k < d; ++k) {
+            Ai[p] = (SuiteSparse_long)(j * d + k);
+            Ax[p++] = 0.0;
         }
     }
-    Ap[nc] = (SuiteSparse_long)(2 * d * nc);
+    Ap[nc] = (SuiteSparse_long)p;
     s->qr = SuiteSparseQR_C_symbolic(s->ordering, 1 /* allow_tol: rank detection */, s->A, &s->cc);
     if (!s->qr) {
         int st = cc_status(s);
@@ -224,11 +228,10 @@ static int spqr_setup(void *state, const odhs_network *net)
     double *Ax = s->A->x;
     for (size_t c = 0; c < nc; ++c) {
         const double *nv = net->nrm + c * d;
-        double *col = Ax + 2 * d * c;
-        for (size_t k = 0; k < d; ++k) {
-            col[k] = -nv[k];
-            col[d + k] = nv[k];
-        }
+        double *col = Ax + ((SuiteSparse_long *)s->A->p)[c];
+        for (size_t k = 0; k < d; ++k) col[k] = -nv[k];
+        if (net->cj[c] < net->n)
+            for (size_t k = 0; k < d; ++k) col[d + k] = nv[k];
     }
     if (!SuiteSparseQR_C_numeric(s->tol, s->A, s->qr, &s->cc)) {
         st = cc_status(s);
