@@ -437,13 +437,14 @@ static double skin_rate(const odhs_stepper *st, const double *G, const double *v
 }
 
 static double predict_walls(const odhs_stepper *st, const double *G, const double *vel, double best, double vtol,
-                            int moving, size_t *pi, size_t *pj);
+                            int moving, int current, size_t *pi, size_t *pj);
+static double pair_velocity(const odhs_stepper *st, size_t i, size_t j);
 
 /* ---- collision prediction ------------------------------------------------ */
 /* earliest time in [0, horizon] at which a non-contact pair touches when
  * separations move as d + t (G d + vel_j - vel_i) */
 static double predict(const odhs_stepper *st, const double *G, const double *vel, double horizon,
-                      double vtol, int moving, size_t *pi, size_t *pj)
+                      double vtol, int moving, int current, size_t *pi, size_t *pj)
 {
     const odhs_system *s = st->sys;
     int dim = st->dim;
@@ -471,7 +472,14 @@ static double predict(const odhs_stepper *st, const double *G, const double *vel
         double t;
         if (c <= 0.0) {
             /* touching (round-off): a collision now if really approaching */
-            if (-b <= vtol * sqrt(dd)) continue;
+            /* the approach of a touching pair is that of the current state
+             * (the rewiring judges it by the same velocities), not the
+             * chord's: else a pair could be added and removed forever */
+            if (!current) {
+                if (-b <= vtol * sqrt(dd)) continue;
+            } else if (pair_velocity(st, i, j) >= -vtol) {
+                continue;
+            }
             t = 0.0;
         } else {
             double disc = b * b - a * c;
@@ -484,7 +492,7 @@ static double predict(const odhs_stepper *st, const double *G, const double *vel
             *pj = j;
         }
     }
-    if (st->net->nwalls) best = predict_walls(st, G, vel, best, vtol, moving, pi, pj);
+    if (st->net->nwalls) best = predict_walls(st, G, vel, best, vtol, moving, current, pi, pj);
     return best;
 }
 
@@ -492,7 +500,7 @@ static double predict(const odhs_stepper *st, const double *G, const double *vel
  * touches it, moving as x + t (G x + vel) against walls translating with their
  * velocities (moving = 1) or at rest (moving = 0, the drift correction) */
 static double predict_walls(const odhs_stepper *st, const double *G, const double *vel, double best, double vtol,
-                            int moving, size_t *pi, size_t *pj)
+                            int moving, int current, size_t *pi, size_t *pj)
 {
     const odhs_system *s = st->sys;
     const odhs_network *net = st->net;
@@ -515,7 +523,8 @@ static double predict_walls(const odhs_stepper *st, const double *G, const doubl
             if (odhs__net_find(net, i, st->n + w) != SIZE_MAX) continue;
             double t = INFINITY;
             if (g0 <= 0.0) {
-                if (un > vtol) t = 0.0; /* touching (round-off) and approaching */
+                /* touching (round-off) and approaching in the current state */
+                if (current ? pair_velocity(st, i, st->n + w) < -vtol : un > vtol) t = 0.0;
             } else if (wl->type == ODHS_WALL_PLANE) {
                 t = g0 / un;
             } else if (wl->type == ODHS_WALL_SPHERE) {
@@ -885,7 +894,7 @@ static int correct(odhs_stepper *st, int *added)
         odhs__net_ST(net, st->cx, st->tmp);
         for (size_t k = 0; k < st->nd; ++k) st->tmp[k] = -st->tmp[k];
         size_t pi, pj;
-        double t = predict(st, Z, st->tmp, 1.0, 0.0, 0, &pi, &pj);
+        double t = predict(st, Z, st->tmp, 1.0, 0.0, 0, 0, &pi, &pj);
         advance(st, Z, st->tmp, t);
         if (pi != SIZE_MAX) {
             size_t c = odhs__net_add(net, pi, pj, ODHS_CONTACT_TEMPORARY);
@@ -1104,7 +1113,7 @@ again:;
         if (rate * tplan > 0.9 * st->skin) tplan = 0.9 * st->skin / rate;
     }
     size_t ci, cj;
-    double t = predict(st, G, vel, tplan, EPS_V * velocity_scale(st), 1, &ci, &cj);
+    double t = predict(st, G, vel, tplan, EPS_V * velocity_scale(st), 1, 1, &ci, &cj);
     advance(st, G, vel, t);
     if (st->net->nwalls) advance_walls(st, t);
     for (size_t k = 0; k < st->nd; ++k)
@@ -1154,7 +1163,10 @@ again:;
             if (tstar < 0.999 * t) {
                 if ((s = restart_step(st))) goto fail;
                 relocated = 1;
-                limit = tstar * (1.0 + 1e-9);
+                /* a force that starts at (almost) zero would give steps of
+                 * no length forever: end the step a little later, where the
+                 * force is negative and the rewiring opens the contact */
+                limit = fmax(tstar * (1.0 + 1e-9), 1e-6 * t);
                 goto again;
             }
         } else if (s) {

@@ -1,0 +1,318 @@
+/* hopper - hard discs falling through a 2D funnel under gravity, with libodhs.
+ *
+ * With no arguments: 300 bidisperse discs (radii 0.5 and 0.7, 50:50) start
+ * at random above a funnel of two segment walls (45 degrees) with an outlet
+ * of width 3.2 (in units of the small diameter), and fall under gravity (a
+ * weight proportional to the disc area). The box is periodic: discs that
+ * leave through the outlet fall on and re-enter at the top, so the hopper
+ * keeps discharging until an arch of discs clogs the outlet (the scene of
+ * Fig. 2.1 of Vagberg's thesis). The program reports the discharge, whether
+ * and when the outlet clogs, and draws the final state with the arch in dark
+ * red (--svg).
+ *
+ * Build against an installed libodhs:
+ *     cc hopper.c $(pkg-config --cflags --libs odhs) -lm -o hopper
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <odhs.h>
+
+#include "cli.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: hopper [options]\n"
+            "  --n N              number of discs (default 300)\n"
+            "  --outlet D         outlet width in small diameters (default 3.2)\n"
+            "  --width W          box width (default 24)\n"
+            "  --time T           longest run, in units of tau (default 400)\n"
+            "  --every X          output interval in tau (default 1)\n"
+            "  --seed S           random seed (default 1)\n"
+            "  --solver NAME      linear solver (default cholmod-pcg if available, else dense/cg)\n"
+            "  --series FILE.csv  time,discharged,mean_speed,z,events per interval\n"
+            "  --svg FILE.svg     picture of the final state (walls grey, arch dark red)\n"
+            "  --out FILE.xyz     final configuration\n"
+            "  --help             this message\n"
+            "Time in units of tau = lambda/(xi0 f_rms) (lambda the mean diameter, f_rms the\n"
+            "rms weight); the weight of a disc is proportional to its area.\n"
+            "Exit status 0 whether or not the outlet clogged (stdout says which).\n");
+}
+
+#define CHECK(call)                                                                             \
+    do {                                                                                        \
+        int rc_ = (call);                                                                       \
+        if (rc_ < 0) {                                                                          \
+            fprintf(stderr, "hopper: %s failed: %s\n", #call, odhs_strerror(rc_));              \
+            return 1;                                                                           \
+        }                                                                                       \
+    } while (0)
+
+/* the arch: the lowest chain of contacts from a disc touching the left funnel
+ * wall to one touching the right wall (Dijkstra, cost of a disc = its height
+ * above the outlet + 1) */
+static size_t find_arch(const odhs_network *net, size_t n, const double *x, double yout, unsigned char *mark)
+{
+    size_t nc = odhs_network_count(net);
+    size_t *deg = calloc(n + 1, sizeof *deg), *adj = malloc(2 * nc * sizeof *adj + 1);
+    double *cost = malloc(n * sizeof *cost);
+    size_t *prev = malloc(n * sizeof *prev);
+    unsigned char *done = calloc(n, 1), *left = calloc(n, 1), *right = calloc(n, 1);
+    size_t found = 0;
+    if (!deg || !adj || !cost || !prev || !done || !left || !right) goto out;
+    for (size_t c = 0; c < nc; ++c) {
+        size_t i, j;
+        int kind;
+        odhs_network_get_contact(net, c, &i, &j, &kind);
+        if (j == n + 0) left[i] = 1;
+        else if (j == n + 1) right[i] = 1;
+        else if (j < n) {
+            deg[i + 1]++;
+            deg[j + 1]++;
+        }
+    }
+    for (size_t i = 0; i < n; ++i) deg[i + 1] += deg[i];
+    size_t *fill = calloc(n, sizeof *fill);
+    if (!fill) goto out;
+    for (size_t c = 0; c < nc; ++c) {
+        size_t i, j;
+        odhs_network_get_contact(net, c, &i, &j, NULL);
+        if (j >= n) continue;
+        adj[deg[i] + fill[i]++] = j;
+        adj[deg[j] + fill[j]++] = i;
+    }
+    free(fill);
+    for (size_t i = 0; i < n; ++i) {
+        /* only discs near the outlet can take part */
+        double h = x[2 * i + 1] - yout;
+        cost[i] = left[i] && h < 6.0 ? h + 1.0 : INFINITY;
+        prev[i] = SIZE_MAX;
+    }
+    for (;;) {
+        size_t u = SIZE_MAX;
+        for (size_t i = 0; i < n; ++i)
+            if (!done[i] && isfinite(cost[i]) && (u == SIZE_MAX || cost[i] < cost[u])) u = i;
+        if (u == SIZE_MAX) break;
+        done[u] = 1;
+        if (right[u]) {
+            for (size_t v = u; v != SIZE_MAX; v = prev[v]) {
+                mark[v] = 2;
+                found++;
+            }
+            break;
+        }
+        for (size_t k = deg[u]; k < deg[u + 1]; ++k) {
+            size_t v = adj[k];
+            double h = x[2 * v + 1] - yout;
+            if (done[v] || h > 6.0) continue;
+            if (cost[u] + h + 1.0 < cost[v]) {
+                cost[v] = cost[u] + h + 1.0;
+                prev[v] = u;
+            }
+        }
+    }
+out:
+    free(deg);
+    free(adj);
+    free(cost);
+    free(prev);
+    free(done);
+    free(left);
+    free(right);
+    return found;
+}
+
+int main(int argc, char **argv)
+{
+    const char *series = NULL, *svg = NULL, *outpath = NULL, *solver_name = NULL;
+    double outlet = 3.2, width = 24.0, tmax = 400.0, every = 1.0;
+    unsigned long n = 300, seed = 1;
+    for (int a = 1; a < argc; ++a) {
+        const char *o = argv[a];
+        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
+            usage(stdout);
+            return 0;
+        }
+        if (a + 1 >= argc) {
+            fprintf(stderr, "hopper: unknown option or missing value: %s\n", o);
+            usage(stderr);
+            return 2;
+        }
+        const char *v = argv[++a];
+        int bad = 0;
+        if (!strcmp(o, "--series")) series = v;
+        else if (!strcmp(o, "--svg")) svg = v;
+        else if (!strcmp(o, "--out")) outpath = v;
+        else if (!strcmp(o, "--solver")) solver_name = v;
+        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 1;
+        else if (!strcmp(o, "--outlet")) bad = cli_double(v, &outlet) || outlet <= 1.0;
+        else if (!strcmp(o, "--width")) bad = cli_double(v, &width) || width < 8.0;
+        else if (!strcmp(o, "--time")) bad = cli_double(v, &tmax) || tmax <= 0;
+        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
+        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
+        else {
+            fprintf(stderr, "hopper: unknown option %s\n", o);
+            usage(stderr);
+            return 2;
+        }
+        if (bad) {
+            fprintf(stderr, "hopper: bad value for %s: %s\n", o, v);
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (outlet >= width - 2.0) {
+        fprintf(stderr, "hopper: the outlet must be narrower than the box\n");
+        return 2;
+    }
+    /* geometry: outlet at height yout, funnel walls at 45 degrees up to the
+     * box edges, discs placed above the funnel, room below for the falling
+     * ones; the box height makes the recycled discs land on the pile */
+    double yout = 12.0, ytop = yout + 0.5 * (width - outlet);
+    double area = 0.0;
+    double *r = malloc(n * sizeof *r), *x = malloc(2 * n * sizeof *x), *F = malloc(2 * n * sizeof *F);
+    if (!r || !x || !F) return 1;
+    for (size_t i = 0; i < n; ++i) {
+        r[i] = i % 2 ? 0.7 : 0.5;
+        area += 3.14159265358979323846 * r[i] * r[i];
+    }
+    double ystart = ytop + 1.0, hfill = 2.2 * area / width + 4.0;
+    double L[2] = {width, ystart + hfill + 4.0 + yout};
+    srand((unsigned)seed);
+    for (size_t i = 0; i < n; ++i) {
+        int ok = 0;
+        for (int tries = 0; tries < 100000 && !ok; ++tries) {
+            x[2 * i] = width * (rand() / ((double)RAND_MAX + 1.0));
+            x[2 * i + 1] = ystart + r[i] + (hfill - 2 * r[i]) * (rand() / ((double)RAND_MAX + 1.0));
+            ok = 1;
+            for (size_t j = 0; j < i && ok; ++j) {
+                double dx = x[2 * i] - x[2 * j], dy = x[2 * i + 1] - x[2 * j + 1];
+                dx -= width * nearbyint(dx / width);
+                ok = dx * dx + dy * dy > (r[i] + r[j]) * (r[i] + r[j]) * 1.0001;
+            }
+        }
+        if (!ok) {
+            fprintf(stderr, "hopper: cannot place %lu discs above the funnel\n", n);
+            return 1;
+        }
+        F[2 * i] = 0.0;
+        F[2 * i + 1] = -(r[i] / 0.5) * (r[i] / 0.5); /* weight ~ area */
+    }
+    odhs_system *sys;
+    CHECK(odhs_system_create(2, n, &sys));
+    int rc = odhs_system_set_configuration(sys, L, 0.0, r, x);
+    if (rc) {
+        fprintf(stderr, "hopper: %s\n", odhs_system_errmsg(sys));
+        return 1;
+    }
+    if (!solver_name) solver_name = cli_default_solver(n);
+    odhs_solver *solver;
+    rc = odhs_solver_create_by_name(solver_name, &solver);
+    if (rc) {
+        fprintf(stderr, "hopper: solver %s: %s\n", solver_name, odhs_strerror(rc));
+        return 2;
+    }
+    odhs_driver *drv;
+    odhs_stepper *st;
+    CHECK(odhs_driver_create(&drv));
+    CHECK(odhs_driver_set_forces(drv, n, 2, F));
+    CHECK(odhs_stepper_create(sys, drv, solver, &st));
+    double a0[2] = {0.0, ytop}, b0[2] = {0.5 * (width - outlet), yout};
+    double a1[2] = {0.5 * (width + outlet), yout}, b1[2] = {width, ytop};
+    CHECK(odhs_stepper_add_wall_segment(st, a0, b0, NULL)); /* wall 0: left  */
+    CHECK(odhs_stepper_add_wall_segment(st, a1, b1, NULL)); /* wall 1: right */
+    CHECK(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_HEUN));
+    CHECK(odhs_stepper_set_tolerance(st, 1e-3));
+    CHECK(odhs_stepper_set_dt(st, 0.05));
+    double tau;
+    CHECK(odhs_driver_time_unit(drv, sys, &tau));
+    fprintf(stderr, "hopper: N = %lu, outlet %.2f, box %.1f x %.1f, solver %s, tau = %.4g\n", n, outlet, L[0], L[1],
+            odhs_solver_name(solver), tau);
+
+    FILE *csv = NULL;
+    if (series) {
+        csv = fopen(series, "w");
+        if (!csv) {
+            fprintf(stderr, "hopper: cannot write %s: %s\n", series, strerror(errno));
+            return 1;
+        }
+        fprintf(csv, "time,discharged,mean_speed,z,events\n");
+    }
+    double *xp = malloc(2 * n * sizeof *xp), *V = malloc(2 * n * sizeof *V);
+    if (!xp || !V) return 1;
+    odhs_system_get_positions(sys, xp);
+    unsigned long discharged = 0;
+    double t = 0.0, t_last = -1.0, t_clog = -1.0, vfree = 2.0; /* speed of a free large disc */
+    printf("%10s %11s %12s %8s %10s\n", "time/tau", "discharged", "mean_speed", "z", "events");
+    long nout = (long)ceil(tmax / every - 1e-9);
+    for (long q = 1; q <= nout; ++q) {
+        rc = odhs_stepper_run_until_time(st, fmin(q * every, tmax) * tau);
+        if (rc) {
+            fprintf(stderr, "\nhopper: stopped: %s (%s)\n", odhs_strerror(rc), odhs_stepper_errmsg(st));
+            break;
+        }
+        odhs_stepper_time(st, &t);
+        odhs_system_get_positions(sys, x);
+        for (size_t i = 0; i < n; ++i)
+            if (x[2 * i + 1] - xp[2 * i + 1] > 0.5 * L[1]) { /* wrapped: left through the bottom */
+                discharged++;
+                t_last = t / tau;
+            }
+        memcpy(xp, x, 2 * n * sizeof *x);
+        odhs_stepper_velocities(st, V);
+        double vmean = 0.0, vmax = 0.0, z;
+        for (size_t i = 0; i < n; ++i) {
+            double v = hypot(V[2 * i], V[2 * i + 1]);
+            vmean += v / (double)n;
+            vmax = fmax(vmax, v);
+        }
+        uint64_t nc, no;
+        odhs_stepper_counts(st, NULL, &nc, &no);
+        odhs_stepper_coordination(st, &z);
+        printf("%10.2f %11lu %12.4e %8.4f %10llu\n", t / tau, discharged, vmean, z, (unsigned long long)(nc + no));
+        if (csv) fprintf(csv, "%.6g,%lu,%.6e,%.6f,%llu\n", t / tau, discharged, vmean, z, (unsigned long long)(nc + no));
+        fprintf(stderr, "\rhopper: t = %.1f tau, %lu discharged, mean speed %.3g   ", t / tau, discharged, vmean);
+        if (vmax < 1e-9 * vfree) { /* everything at rest: the outlet is clogged */
+            t_clog = t / tau;
+            break;
+        }
+    }
+    fprintf(stderr, "\n");
+    unsigned char *mark = calloc(n, 1);
+    size_t arch = 0;
+    if (t_clog >= 0.0 && mark) arch = find_arch(odhs_stepper_network(st), n, x, yout, mark);
+    if (t_clog >= 0.0)
+        printf("clogged: yes, at rest by t = %.2f tau; last disc out at t = %.2f tau; %lu discharged; arch of %zu "
+               "discs\n",
+               t_clog, t_last, discharged, arch);
+    else
+        printf("clogged: no within %.1f tau; %lu discharged (%.3f per tau)\n", t / tau, discharged,
+               discharged / (t / tau));
+    if (csv && fclose(csv)) {
+        fprintf(stderr, "hopper: error writing %s\n", series);
+        return 1;
+    }
+    if (svg && odhs_svg_write(sys, odhs_stepper_network(st), mark, svg)) {
+        fprintf(stderr, "hopper: cannot write %s: %s\n", svg, odhs_system_errmsg(sys));
+        return 1;
+    }
+    if (outpath && odhs_xyz_write(sys, outpath)) {
+        fprintf(stderr, "hopper: cannot write %s: %s\n", outpath, odhs_system_errmsg(sys));
+        return 1;
+    }
+    free(mark);
+    free(xp);
+    free(V);
+    free(r);
+    free(x);
+    free(F);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(solver);
+    odhs_system_destroy(sys);
+    return rc < 0 ? 1 : 0;
+}
