@@ -110,6 +110,10 @@ static int eval_forces(odhs_stepper *st)
     } else {
         st->has_F = 0;
     }
+    /* self-propulsion and gravity add to the above */
+    if ((d->prop_on || d->grav_on) && odhs__driver_extra_forces(d, st->sys, st->F, &st->has_F))
+        return sterr(st, ODHS_E_DIM, "self-propulsion or gravity settings do not fit N = %zu, d = %d", st->n,
+                     st->dim);
     return ODHS_OK;
 }
 
@@ -666,6 +670,9 @@ static int check_driver(odhs_stepper *st)
     if (d->F && (d->Fn != st->n || d->Fdim != st->dim))
         return sterr(st, ODHS_E_DIM, "driver forces are for N = %zu, d = %d, the system has N = %zu, d = %d",
                      d->Fn, d->Fdim, st->n, st->dim);
+    if (odhs__driver_check_extra(d, st->n, st->dim))
+        return sterr(st, ODHS_E_DIM, "self-propulsion or gravity settings do not fit N = %zu, d = %d", st->n,
+                     st->dim);
     return ODHS_OK;
 }
 
@@ -682,6 +689,7 @@ int odhs_stepper_reset(odhs_stepper *st)
     st->lambda = 0.0;
     for (size_t i = 0; i < st->n; ++i) st->lambda += 2.0 * st->sys->r[i];
     st->lambda /= (double)st->n;
+    odhs__prop_start(st->drv, st->time, st->lambda); /* self-propulsion clock */
     /* keep permanent contacts, rebuild the temporary ones; an error puts
      * the configuration and the network back as they were (rollback) */
     odhs_network *net = st->net;
@@ -901,14 +909,20 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     /* step bookkeeping that rollback() does not cover */
     const uint64_t drv_version0 = st->drv_version, nrejected0 = st->nrejected;
     const double tau0 = st->tau, h0 = st->h;
+    int psaved = 0; /* self-propulsion state saved for the rollback */
     st->nchg = 0;
-    if (st->drv_version != st->drv->version) {
-        /* the driver changed since the forces were solved: re-solve now */
+    if (st->drv_version != st->drv->version || odhs__prop_next(st->drv) <= st->time) {
+        /* the driver changed since the forces were solved (or propulsion
+         * switches are overdue, e.g. on a driver shared by steppers): re-solve */
         if ((s = check_driver(st))) goto fail;
         if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) {
             s = sterr(st, s, "%s", st->drv->errmsg);
             goto fail;
         }
+        odhs__prop_save(st->drv);
+        psaved = 1;
+        odhs__prop_start(st->drv, st->time, st->lambda);
+        odhs__prop_switch(st->drv, st->time, st->lambda);
         if ((s = eval_forces(st)) || (s = rewire(st))) goto fail;
         st->drv_version = st->drv->version;
         if (st->nchg) {
@@ -924,6 +938,9 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
         memcpy(st->disps, st->disp, st->nd * sizeof *st->disps);
         memcpy(st->Ms, st->M, sizeof st->Ms);
     }
+    /* self-propulsion: a step ends exactly at the next switch time */
+    const double tsw = odhs__prop_next(st->drv), dsw = tsw - st->time;
+    if (dsw <= limit) limit = dsw;
 again:;
     double tplan = st->dt * st->tau;
     if (limit < tplan) tplan = limit;
@@ -956,7 +973,8 @@ again:;
         s = sterr(st, ODHS_E_NONFINITE, "the box became degenerate after a step of %g", t);
         goto fail;
     }
-    st->time += t;
+    const int at_switch = ci == SIZE_MAX && t == dsw; /* the step reached the switch time */
+    st->time = at_switch ? tsw : st->time + t;
     st->strain += t * st->drv->gdot;
     st->nsteps++;
     odhs_network *net = st->net;
@@ -1001,6 +1019,13 @@ again:;
             goto fail;
         }
     }
+    if (at_switch) {
+        /* new propulsion forces from the switch time on */
+        if (!psaved) odhs__prop_save(st->drv);
+        psaved = 1;
+        odhs__prop_switch(st->drv, st->time, st->lambda);
+        if ((s = eval_forces(st))) goto fail;
+    }
     if ((s = rewire(st))) goto fail;
     if (!st->jammed && st->corr_every && st->nsteps % st->corr_every == 0) {
         int added = 0;
@@ -1013,6 +1038,7 @@ again:;
                      st->time);
     return ODHS_OK;
 fail:
+    if (psaved) odhs__prop_restore(st->drv);
     rollback(st);
     /* the forces are again those of the start of the step: solved for the
      * driver as it was then (a changed driver is re-solved next time) */

@@ -3,7 +3,8 @@
  *
  * A checkpoint holds everything a stepper needs to continue exactly as if it
  * had not stopped: the system (positions, radii, species, box, strain), the
- * driver settings (mobility, rates, pressure, fixed forces), the stepper's
+ * driver settings (mobility, rates, pressure, fixed forces, gravity,
+ * self-propulsion with its random-number state), the stepper's
  * settings and state (time, strain, counters, integrator and adaptive step,
  * the contact network in its order with its forces, velocities, neighbour
  * list and its bookkeeping). Continuing from a checkpoint is bit-identical to
@@ -28,7 +29,7 @@ extern "C" {
 #endif
 
 /** Current checkpoint format version. */
-#define ODHS_CHECKPOINT_VERSION 1
+#define ODHS_CHECKPOINT_VERSION 2
 
 /**
  * Save the stepper's simulation to path (atomically). The stepper must be
