@@ -48,7 +48,7 @@
  * switch time t the particles due, in index order, the same way.
  * The clock starts when a stepper first takes the setting (its reset or next
  * step): switch times are then t0 + persistence * tau_p, t0 the stepper's
- * time. A driver with self-propulsion follows the clock of one stepper; share
+ * time; later persistence times use the tau_p (xi0) current when drawn. A driver with self-propulsion follows the clock of one stepper; share
  * it between steppers only if they run in lock step.
  *
  * Gravity: a uniform field g adds F_i = w_i g to every particle, with weight
