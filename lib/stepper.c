@@ -680,7 +680,7 @@ static int check_driver(odhs_stepper *st)
 int odhs_stepper_reset(odhs_stepper *st)
 {
     if (!st) return ODHS_E_NULL;
-    int s;
+    int s, psaved = 0;
     st->ready = 0;
     st->jammed = 0;
     odhs__solver_invalidate(st->sol); /* our network may reuse a freed address */
@@ -689,7 +689,6 @@ int odhs_stepper_reset(odhs_stepper *st)
     st->lambda = 0.0;
     for (size_t i = 0; i < st->n; ++i) st->lambda += 2.0 * st->sys->r[i];
     st->lambda /= (double)st->n;
-    odhs__prop_start(st->drv, st->time, st->lambda); /* self-propulsion clock */
     /* keep permanent contacts, rebuild the temporary ones; an error puts
      * the configuration and the network back as they were (rollback) */
     odhs_network *net = st->net;
@@ -705,6 +704,9 @@ int odhs_stepper_reset(odhs_stepper *st)
         goto fail;
     }
     if ((s = build_neighbours(st))) goto fail;
+    odhs__prop_save(st->drv); /* an error leaves the propulsion clock as it was */
+    psaved = 1;
+    odhs__prop_start(st->drv, st->time, st->lambda);
     if ((s = eval_forces(st))) goto fail;
     st->nchg = 0;
     if ((s = rewire(st))) goto fail;
@@ -713,6 +715,7 @@ int odhs_stepper_reset(odhs_stepper *st)
     st->ready = 1;
     return ODHS_OK;
 fail:
+    if (psaved) odhs__prop_restore(st->drv);
     if (s < 0) rollback(st);
     st->nchg = 0;
     return s;
