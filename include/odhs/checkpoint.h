@@ -12,9 +12,13 @@
  * Not saved (they are code, not data): force and event callbacks, and the
  * solver itself: set them again on the restored handles.
  *
- * Format (version 1): little-endian binary; magic "ODHSCKPT", a format
- * version, then tagged sections, then a 64-bit FNV-1a checksum of all
- * preceding bytes. Writes go to a temporary file in the same directory that is
+ * Format: little-endian binary; magic "ODHSCKPT", a format version, then
+ * tagged sections, then a 64-bit FNV-1a checksum of all preceding bytes.
+ * Version 1: sections SYS, DRV, STP, NET. Version 2 adds optional sections
+ * after NET, each at most once: PROP (self-propulsion: settings, whether its
+ * clock runs, the xoshiro256** state, current forces and switch times) and
+ * GRAV (gravity field and weights). A checkpoint that needs neither is still
+ * written as version 1, so older releases read it; this library reads both. Writes go to a temporary file in the same directory that is
  * flushed, synced and renamed over the target, so a crash mid-write leaves any
  * previous checkpoint intact. A truncated, corrupted or foreign file gives
  * ODHS_E_FORMAT and no handle.
