@@ -18,9 +18,10 @@
  * after NET, each at most once: PROP (self-propulsion: settings, whether its
  * clock runs, the xoshiro256** state, current forces and switch times) and
  * GRAV (gravity field and weights). A checkpoint that needs neither is still
- * written as version 1, so older releases read it; this library reads both. Writes go to a temporary file in the same directory that is
- * flushed, synced and renamed over the target, so a crash mid-write leaves any
- * previous checkpoint intact. A truncated, corrupted or foreign file gives
+ * written as version 1, so older releases read it; this library reads both.
+ * Writes go to a temporary file in the same directory that is flushed, synced
+ * and renamed over the target, so a crash mid-write leaves any previous
+ * checkpoint intact. A truncated, corrupted or foreign file gives
  * ODHS_E_FORMAT and no handle.
  */
 #ifndef ODHS_CHECKPOINT_H
