@@ -25,6 +25,8 @@ static void usage(FILE *f)
             "  --in FILE.xyz      start from a configuration file (extended XYZ)\n"
             "  --strain X         total strain (default 0.2)\n"
             "  --out FILE.xyz     write the final configuration\n"
+            "  --svg FILE.svg     picture of the final state (discs coloured by size,\n"
+            "                     contact forces as lines of width proportional to the force)\n"
             "  --series FILE.csv  write strain,shear_stress,pressure,z,events per interval\n"
             "  --every X          output interval in strain (default 0.01)\n"
             "  --dt X             step in strain units (default 1e-3; the largest step\n"
@@ -96,7 +98,7 @@ static int build_scene(int dim, unsigned long n, double phi, unsigned long seed,
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *solver_name = "cg", *integrator = "euler";
+    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = "cg", *integrator = "euler";
     double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 1e-6;
     unsigned long n = 256, seed = 1, dim = 2;
     for (int a = 1; a < argc; ++a) {
@@ -115,6 +117,7 @@ int main(int argc, char **argv)
         if (!strcmp(o, "--in")) in = v;
         else if (!strcmp(o, "--out")) outpath = v;
         else if (!strcmp(o, "--series")) series = v;
+        else if (!strcmp(o, "--svg")) svg = v;
         else if (!strcmp(o, "--solver")) solver_name = v;
         else if (!strcmp(o, "--integrator")) {
             integrator = v;
@@ -228,6 +231,13 @@ int main(int argc, char **argv)
     if (csv && fclose(csv)) {
         fprintf(stderr, "shear_flow: error writing %s\n", series);
         return 1;
+    }
+    if (svg) {
+        int w = odhs_svg_write(sys, odhs_stepper_network(st), NULL, svg);
+        if (w) {
+            fprintf(stderr, "shear_flow: cannot write %s: %s\n", svg, odhs_system_errmsg(sys));
+            return 1;
+        }
     }
     if (outpath) {
         rc = odhs_xyz_write(sys, outpath);

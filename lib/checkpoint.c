@@ -81,7 +81,9 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
     size_t n = sys->n, nd = st->nd;
     wbuf b = {NULL, 0, 0, 0};
     put(&b, MAGIC, 8);
-    put_u64(&b, ODHS_CHECKPOINT_VERSION);
+    /* version 1 unless a section of version 2 is needed, so that files
+     * without them stay readable by older releases */
+    put_u64(&b, drv->prop_on || drv->grav_on || net->nwalls || net->nperm || net->rbody ? 2u : 1u);
     /* system */
     put_tag(&b, "SYS ");
     put_u64(&b, (uint64_t)sys->dim);
@@ -170,6 +172,27 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
         put_u64(&b, net->rbody ? 1u : 0u);
         if (net->rbody)
             for (size_t i = 0; i < n; ++i) put_u64(&b, net->rbody[i] == SIZE_MAX ? UINT64_MAX : net->rbody[i]);
+    }
+    /* optional sections (version 2) */
+    if (drv->prop_on) {
+        put_tag(&b, "PROP");
+        put_u64(&b, drv->pn);
+        put_u64(&b, (uint64_t)drv->pdim);
+        put_f64(&b, drv->pfmin);
+        put_f64(&b, drv->pfmax);
+        put_f64(&b, drv->ptmin);
+        put_f64(&b, drv->ptmax);
+        put_u64(&b, (uint64_t)drv->prop_started);
+        for (int k = 0; k < 4; ++k) put_u64(&b, drv->prng.s[k]);
+        put_f64s(&b, drv->pF, drv->pn * (size_t)drv->pdim);
+        put_f64s(&b, drv->pts, drv->pn);
+    }
+    if (drv->grav_on) {
+        put_tag(&b, "GRAV");
+        put_u64(&b, (uint64_t)drv->gdim);
+        put_f64s(&b, drv->g, 3);
+        put_u64(&b, drv->gw ? drv->gwn : 0u);
+        if (drv->gw) put_f64s(&b, drv->gw, drv->gwn);
     }
     put_tag(&b, "END ");
     put_u64(&b, b.nomem ? 0 : fnv1a(b.p, b.len));
@@ -314,8 +337,8 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     }
     rbuf b = {p, len - 12, 8, 0};
     uint64_t version = get_u64(&b);
-    if (version != ODHS_CHECKPOINT_VERSION)
-        FAIL(ODHS_E_FORMAT, "checkpoint: format version %llu not supported (this library reads %d)",
+    if (version < 1 || version > ODHS_CHECKPOINT_VERSION)
+        FAIL(ODHS_E_FORMAT, "checkpoint: format version %llu not supported (this library reads 1 to %d)",
              (unsigned long long)version, ODHS_CHECKPOINT_VERSION);
     /* system */
     if (tag(&b, "SYS ")) FAIL(ODHS_E_FORMAT, "checkpoint: system section missing");
@@ -427,8 +450,8 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         st->pj[q] = (size_t)j;
     }
     st->npairs = (size_t)npairs;
-    /* walls */
-    if (peek_tag(&b, "WAL ")) {
+    /* walls (version 2) */
+    if (version >= 2 && peek_tag(&b, "WAL ")) {
         tag(&b, "WAL ");
         uint64_t nw = get_u64(&b);
         if (b.bad || nw > (b.len - b.pos) / 8) FAIL(ODHS_E_FORMAT, "checkpoint: bad wall count");
@@ -470,7 +493,7 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         if (k == SIZE_MAX) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
         st->net->f[k] = f;
     }
-    if (peek_tag(&b, "CMP ")) {
+    if (version >= 2 && peek_tag(&b, "CMP ")) {
         odhs_network *net = st->net;
         tag(&b, "CMP ");
         uint64_t np = get_u64(&b);
@@ -496,12 +519,62 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
             }
         }
     }
+    /* optional sections of version 2, each at most once, in any order */
+    while (version >= 2 && b.pos < b.len && !b.bad) {
+        char t4[4];
+        get(&b, t4, 4);
+        if (!memcmp(t4, "PROP", 4) && !drv->prop_on) {
+            uint64_t pn = get_u64(&b), pdim = get_u64(&b);
+            double fmin = get_f64(&b), fmax = get_f64(&b), tmin = get_f64(&b), tmax = get_f64(&b);
+            uint64_t started = get_u64(&b);
+            odhs_rng rng;
+            for (int k = 0; k < 4; ++k) rng.s[k] = get_u64(&b);
+            if (b.bad || (pdim != 2 && pdim != 3) || pn == 0 || pn > (b.len - b.pos) / 8 / (pdim + 1) ||
+                started > 1 || !isfinite(fmin) || !isfinite(fmax) || !isfinite(tmin) || !isfinite(tmax) ||
+                !(fmin >= 0.0) || !(fmax > 0.0) || fmin > fmax || !(tmin >= 0.0) || !(tmax > 0.0) || tmin > tmax ||
+                (rng.s[0] | rng.s[1] | rng.s[2] | rng.s[3]) == 0)
+                FAIL(ODHS_E_FORMAT, "checkpoint: self-propulsion section malformed");
+            if (odhs__prop_alloc(drv, (size_t)pn, (int)pdim)) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
+            drv->pfmin = fmin;
+            drv->pfmax = fmax;
+            drv->ptmin = tmin;
+            drv->ptmax = tmax;
+            drv->prop_started = (int)started;
+            drv->prng = rng;
+            get_f64s(&b, drv->pF, (size_t)pn * (size_t)pdim);
+            get_f64s(&b, drv->pts, (size_t)pn);
+            if (b.bad || !finite_all(drv->pF, (size_t)pn * (size_t)pdim) || !finite_all(drv->pts, (size_t)pn))
+                FAIL(ODHS_E_FORMAT, "checkpoint: bad self-propulsion state");
+        } else if (!memcmp(t4, "GRAV", 4) && !drv->grav_on) {
+            uint64_t gdim = get_u64(&b);
+            double g[3];
+            get_f64s(&b, g, 3);
+            uint64_t nw = get_u64(&b);
+            if (b.bad || (gdim != 2 && gdim != 3) || !finite_all(g, 3) || nw > (b.len - b.pos) / 8)
+                FAIL(ODHS_E_FORMAT, "checkpoint: gravity section malformed");
+            if ((s = odhs_driver_set_gravity(drv, (int)gdim, g))) FAIL(s, "checkpoint: %s", odhs_strerror(s));
+            if (nw) {
+                odhs__free(tmpF);
+                tmpF = odhs__malloc_array((size_t)nw, sizeof *tmpF);
+                if (!tmpF) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
+                get_f64s(&b, tmpF, (size_t)nw);
+                if (b.bad || !finite_all(tmpF, (size_t)nw)) FAIL(ODHS_E_FORMAT, "checkpoint: bad gravity weights");
+                if ((s = odhs_driver_set_gravity_weights(drv, (size_t)nw, tmpF)))
+                    FAIL(s, "checkpoint: %s", odhs_strerror(s));
+            }
+        } else {
+            FAIL(ODHS_E_FORMAT, "checkpoint: unknown or repeated section");
+        }
+    }
     if (b.pos != b.len) FAIL(ODHS_E_FORMAT, "checkpoint: unexpected trailing data");
     odhs__net_geometry(st->net, sys);
+    st->has_F = 0;
     if (drv->F) {
         memcpy(st->F, drv->F, nd * sizeof *st->F);
         st->has_F = 1;
     }
+    /* the forces as eval_forces computes them (a mismatch fails the next step) */
+    odhs__driver_extra_forces(drv, sys, st->F, &st->has_F);
     st->drv_version = drv->version;
     st->ready = 1;
     odhs__free(tmpF);

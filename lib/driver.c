@@ -15,6 +15,9 @@ static int drverr(const odhs_driver *d, int status, const char *fmt, ...)
     return status;
 }
 
+static double prop_f2(const odhs_driver *d);
+static double grav_weight(const odhs_driver *d, const odhs_system *sys, size_t i, double amean);
+
 int odhs_driver_create(odhs_driver **out)
 {
     if (!out) return ODHS_E_NULL;
@@ -30,6 +33,11 @@ void odhs_driver_destroy(odhs_driver *drv)
 {
     if (!drv) return;
     odhs__free(drv->F);
+    odhs__free(drv->pF);
+    odhs__free(drv->pts);
+    odhs__free(drv->pF_b);
+    odhs__free(drv->pts_b);
+    odhs__free(drv->gw);
     odhs__free(drv);
 }
 
@@ -191,16 +199,298 @@ int odhs_driver_time_unit(const odhs_driver *drv, const odhs_system *sys, double
     double lam = 0.0;
     for (size_t i = 0; i < sys->n; ++i) lam += 2.0 * sys->r[i];
     lam /= (double)sys->n;
-    if (drv->F) {
+    if (drv->grav_on && odhs__driver_check_extra(drv, sys->n, sys->dim) == ODHS_OK) {
+        /* deterministic forces: fixed plus gravity, summed per particle */
+        double s = 0.0, amean = 0.5 * lam;
+        int dim = sys->dim;
+        int fixed = drv->F && drv->Fn == sys->n && drv->Fdim == dim;
+        for (size_t i = 0; i < sys->n; ++i) {
+            double w = grav_weight(drv, sys, i, amean);
+            for (int k = 0; k < dim; ++k) {
+                double f = w * drv->g[k] + (fixed ? drv->F[i * dim + k] : 0.0);
+                s += f * f;
+            }
+        }
+        double f2 = s / (double)sys->n + (drv->prop_on ? prop_f2(drv) : 0.0);
+        if (f2 > 0.0) {
+            *tau = lam / (drv->xi0 * sqrt(f2));
+            return ODHS_OK;
+        }
+    } else if (drv->F) {
         double s = 0.0;
         size_t nd = drv->Fn * (size_t)drv->Fdim;
         for (size_t k = 0; k < nd; ++k) s += drv->F[k] * drv->F[k];
-        double frms = sqrt(s / (double)drv->Fn);
+        double f2 = s / (double)drv->Fn;
+        if (drv->prop_on) f2 += prop_f2(drv);
+        double frms = sqrt(f2);
         if (frms > 0.0) {
             *tau = lam / (drv->xi0 * frms);
             return ODHS_OK;
         }
+    } else if (drv->prop_on) {
+        *tau = lam / (drv->xi0 * odhs__prop_fp(drv));
+        return ODHS_OK;
     }
     *tau = drv->tau_user > 0.0 ? drv->tau_user : lam / drv->xi0;
+    return ODHS_OK;
+}
+
+/* ---- self-propulsion ------------------------------------------------------ */
+static double prop_f2(const odhs_driver *d)
+{
+    return (d->pfmin * d->pfmin + d->pfmin * d->pfmax + d->pfmax * d->pfmax) / 3.0;
+}
+
+double odhs__prop_fp(const odhs_driver *d) { return sqrt(prop_f2(d)); }
+
+static double prop_tau(const odhs_driver *d, double lambda) { return lambda / (d->xi0 * odhs__prop_fp(d)); }
+
+/* force of particle i: direction uniform, magnitude uniform in [fmin, fmax] */
+static void prop_draw_force(odhs_driver *d, size_t i)
+{
+    double *F = d->pF + i * (size_t)d->pdim, e[3];
+    if (d->pdim == 2) {
+        double phi = 2.0 * ODHS_PI * odhs__rng_uniform(&d->prng);
+        e[0] = cos(phi);
+        e[1] = sin(phi);
+    } else {
+        double z = 2.0 * odhs__rng_uniform(&d->prng) - 1.0;
+        double phi = 2.0 * ODHS_PI * odhs__rng_uniform(&d->prng);
+        double rho = sqrt(fmax(0.0, 1.0 - z * z));
+        e[0] = rho * cos(phi);
+        e[1] = rho * sin(phi);
+        e[2] = z;
+    }
+    double f = d->pfmin + (d->pfmax - d->pfmin) * odhs__rng_uniform(&d->prng);
+    for (int k = 0; k < d->pdim; ++k) F[k] = f * e[k];
+}
+
+/* persistence in units of tau_p */
+static double prop_draw_time(odhs_driver *d)
+{
+    return d->ptmin + (d->ptmax - d->ptmin) * odhs__rng_uniform(&d->prng);
+}
+
+static void prop_free(odhs_driver *d)
+{
+    odhs__free(d->pF);
+    odhs__free(d->pts);
+    odhs__free(d->pF_b);
+    odhs__free(d->pts_b);
+    d->pF = d->pts = d->pF_b = d->pts_b = NULL;
+    d->prop_on = d->prop_started = 0;
+    d->pn = 0;
+}
+
+int odhs__prop_alloc(odhs_driver *d, size_t n, int dim)
+{
+    size_t nd = n * (size_t)dim;
+    double *F = odhs__malloc_array(nd, sizeof *F), *Fb = odhs__malloc_array(nd, sizeof *Fb);
+    double *t = odhs__malloc_array(n, sizeof *t), *tb = odhs__malloc_array(n, sizeof *tb);
+    if (!F || !Fb || !t || !tb) {
+        odhs__free(F);
+        odhs__free(Fb);
+        odhs__free(t);
+        odhs__free(tb);
+        return ODHS_E_NOMEM;
+    }
+    prop_free(d);
+    d->pF = F;
+    d->pF_b = Fb;
+    d->pts = t;
+    d->pts_b = tb;
+    d->pn = n;
+    d->pdim = dim;
+    d->prop_on = 1;
+    return ODHS_OK;
+}
+
+int odhs_driver_set_self_propulsion(odhs_driver *drv, size_t n, int dim, double fmin, double fmax, double tmin,
+                                    double tmax, uint64_t seed)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (dim != 2 && dim != 3) return drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
+    if (n == 0) return drverr(drv, ODHS_E_EMPTY, "no particles");
+    if (!isfinite(fmin) || !isfinite(fmax) || !isfinite(tmin) || !isfinite(tmax))
+        return drverr(drv, ODHS_E_NONFINITE, "propulsion parameters must be finite");
+    if (!(fmin >= 0.0) || !(fmax > 0.0) || fmin > fmax)
+        return drverr(drv, ODHS_E_INVALID, "need 0 <= fmin <= fmax and fmax > 0 (got %g, %g)", fmin, fmax);
+    if (!(tmin >= 0.0) || !(tmax > 0.0) || tmin > tmax)
+        return drverr(drv, ODHS_E_INVALID, "need 0 <= tmin <= tmax and tmax > 0 (got %g, %g)", tmin, tmax);
+    if (n > SIZE_MAX / 3 / sizeof(double)) return drverr(drv, ODHS_E_NOMEM, "out of memory");
+    if (odhs__prop_alloc(drv, n, dim)) return drverr(drv, ODHS_E_NOMEM, "out of memory");
+    drv->pfmin = fmin;
+    drv->pfmax = fmax;
+    drv->ptmin = tmin;
+    drv->ptmax = tmax;
+    odhs__rng_seed(&drv->prng, seed);
+    for (size_t i = 0; i < n; ++i) {
+        prop_draw_force(drv, i);
+        drv->pts[i] = prop_draw_time(drv);
+    }
+    drv->prop_started = 0;
+    drv->version++;
+    return ODHS_OK;
+}
+
+int odhs_driver_clear_self_propulsion(odhs_driver *drv)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (drv->prop_on) {
+        prop_free(drv);
+        drv->version++;
+    }
+    return ODHS_OK;
+}
+
+int odhs_driver_get_propulsion(const odhs_driver *drv, double *F, double *tswitch)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (!F && !tswitch) return drverr(drv, ODHS_E_NULL, "both outputs are NULL");
+    if (!drv->prop_on) return drverr(drv, ODHS_E_STATE, "self-propulsion is off");
+    if (tswitch && !drv->prop_started)
+        return drverr(drv, ODHS_E_STATE, "switch times are set when a stepper starts the propulsion clock");
+    if (F) memcpy(F, drv->pF, drv->pn * (size_t)drv->pdim * sizeof *F);
+    if (tswitch) memcpy(tswitch, drv->pts, drv->pn * sizeof *tswitch);
+    return ODHS_OK;
+}
+
+int odhs_driver_next_switch(const odhs_driver *drv, double *t)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (!t) return drverr(drv, ODHS_E_NULL, "output pointer is NULL");
+    if (!drv->prop_on) return drverr(drv, ODHS_E_STATE, "self-propulsion is off");
+    if (!drv->prop_started)
+        return drverr(drv, ODHS_E_STATE, "switch times are set when a stepper starts the propulsion clock");
+    *t = odhs__prop_next(drv);
+    return ODHS_OK;
+}
+
+void odhs__prop_start(odhs_driver *d, double t, double lambda)
+{
+    if (!d->prop_on || d->prop_started) return;
+    double tau = prop_tau(d, lambda);
+    for (size_t i = 0; i < d->pn; ++i) d->pts[i] = t + d->pts[i] * tau;
+    d->prop_started = 1;
+}
+
+double odhs__prop_next(const odhs_driver *d)
+{
+    if (!d->prop_on || !d->prop_started) return INFINITY;
+    double t = INFINITY;
+    for (size_t i = 0; i < d->pn; ++i)
+        if (d->pts[i] < t) t = d->pts[i];
+    return t;
+}
+
+void odhs__prop_switch(odhs_driver *d, double t, double lambda)
+{
+    if (!d->prop_on || !d->prop_started) return;
+    double tau = prop_tau(d, lambda);
+    for (size_t i = 0; i < d->pn; ++i)
+        while (d->pts[i] <= t) {
+            prop_draw_force(d, i);
+            d->pts[i] = t + prop_draw_time(d) * tau;
+        }
+}
+
+void odhs__prop_save(odhs_driver *d)
+{
+    if (!d->prop_on) return;
+    d->prng_b = d->prng;
+    d->pstarted_b = d->prop_started;
+    memcpy(d->pF_b, d->pF, d->pn * (size_t)d->pdim * sizeof *d->pF);
+    memcpy(d->pts_b, d->pts, d->pn * sizeof *d->pts);
+}
+
+void odhs__prop_restore(odhs_driver *d)
+{
+    if (!d->prop_on) return;
+    d->prng = d->prng_b;
+    d->prop_started = d->pstarted_b;
+    memcpy(d->pF, d->pF_b, d->pn * (size_t)d->pdim * sizeof *d->pF);
+    memcpy(d->pts, d->pts_b, d->pn * sizeof *d->pts);
+}
+
+/* ---- gravity ------------------------------------------------------------------ */
+int odhs_driver_set_gravity(odhs_driver *drv, int dim, const double *g)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (!g) {
+        if (drv->grav_on) drv->version++;
+        drv->grav_on = 0;
+        memset(drv->g, 0, sizeof drv->g);
+        return ODHS_OK;
+    }
+    if (dim != 2 && dim != 3) return drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
+    for (int k = 0; k < dim; ++k)
+        if (!isfinite(g[k])) return drverr(drv, ODHS_E_NONFINITE, "gravity component %d is not finite", k);
+    memset(drv->g, 0, sizeof drv->g);
+    memcpy(drv->g, g, (size_t)dim * sizeof *g);
+    drv->gdim = dim;
+    drv->grav_on = 1;
+    drv->version++;
+    return ODHS_OK;
+}
+
+int odhs_driver_set_gravity_weights(odhs_driver *drv, size_t n, const double *w)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (!w) {
+        odhs__free(drv->gw);
+        drv->gw = NULL;
+        drv->gwn = 0;
+        drv->version++;
+        return ODHS_OK;
+    }
+    if (n == 0) return drverr(drv, ODHS_E_EMPTY, "no particles");
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(w[i])) return drverr(drv, ODHS_E_NONFINITE, "weight %zu is not finite", i);
+    double *c = odhs__malloc_array(n, sizeof *c);
+    if (!c) return drverr(drv, ODHS_E_NOMEM, "out of memory");
+    memcpy(c, w, n * sizeof *c);
+    odhs__free(drv->gw);
+    drv->gw = c;
+    drv->gwn = n;
+    drv->version++;
+    return ODHS_OK;
+}
+
+static double grav_weight(const odhs_driver *d, const odhs_system *sys, size_t i, double amean)
+{
+    if (d->gw) return d->gw[i];
+    double q = sys->r[i] / amean;
+    return sys->dim == 2 ? q * q : q * q * q;
+}
+
+int odhs__driver_check_extra(const odhs_driver *d, size_t n, int dim)
+{
+    if (d->prop_on && (d->pn != n || d->pdim != dim)) return ODHS_E_DIM;
+    if (d->grav_on && (d->gdim != dim || (d->gw && d->gwn != n))) return ODHS_E_DIM;
+    return ODHS_OK;
+}
+
+int odhs__driver_extra_forces(const odhs_driver *d, const odhs_system *sys, double *F, int *has)
+{
+    if (!d->prop_on && !d->grav_on) return ODHS_OK;
+    size_t n = sys->n;
+    int dim = sys->dim;
+    size_t nd = n * (size_t)dim;
+    if (odhs__driver_check_extra(d, n, dim)) return ODHS_E_DIM;
+    if (!*has) memset(F, 0, nd * sizeof *F);
+    *has = 1;
+    if (d->prop_on)
+        for (size_t k = 0; k < nd; ++k) F[k] += d->pF[k];
+    if (d->grav_on) {
+        double amean = 0.0;
+        if (!d->gw) {
+            for (size_t i = 0; i < n; ++i) amean += sys->r[i];
+            amean /= (double)n;
+        }
+        for (size_t i = 0; i < n; ++i) {
+            double w = grav_weight(d, sys, i, amean);
+            for (int k = 0; k < dim; ++k) F[i * dim + k] += w * d->g[k];
+        }
+    }
     return ODHS_OK;
 }

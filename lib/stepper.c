@@ -110,6 +110,10 @@ static int eval_forces(odhs_stepper *st)
     } else {
         st->has_F = 0;
     }
+    /* self-propulsion and gravity add to the above */
+    if ((d->prop_on || d->grav_on) && odhs__driver_extra_forces(d, st->sys, st->F, &st->has_F))
+        return sterr(st, ODHS_E_DIM, "self-propulsion or gravity settings do not fit N = %zu, d = %d", st->n,
+                     st->dim);
     return ODHS_OK;
 }
 
@@ -819,6 +823,9 @@ static int check_driver(odhs_stepper *st)
     if (d->F && (d->Fn != st->n || d->Fdim != st->dim))
         return sterr(st, ODHS_E_DIM, "driver forces are for N = %zu, d = %d, the system has N = %zu, d = %d",
                      d->Fn, d->Fdim, st->n, st->dim);
+    if (odhs__driver_check_extra(d, st->n, st->dim))
+        return sterr(st, ODHS_E_DIM, "self-propulsion or gravity settings do not fit N = %zu, d = %d", st->n,
+                     st->dim);
     return ODHS_OK;
 }
 
@@ -826,7 +833,7 @@ static int check_driver(odhs_stepper *st)
 int odhs_stepper_reset(odhs_stepper *st)
 {
     if (!st) return ODHS_E_NULL;
-    int s;
+    int s, psaved = 0;
     st->ready = 0;
     st->jammed = 0;
     odhs__solver_invalidate(st->sol); /* our network may reuse a freed address */
@@ -851,6 +858,9 @@ int odhs_stepper_reset(odhs_stepper *st)
         goto fail;
     }
     if ((s = build_neighbours(st))) goto fail;
+    odhs__prop_save(st->drv); /* an error leaves the propulsion clock as it was */
+    psaved = 1;
+    odhs__prop_start(st->drv, st->time, st->lambda);
     if ((s = eval_forces(st))) goto fail;
     st->nchg = 0;
     if ((s = rewire(st))) goto fail;
@@ -859,6 +869,7 @@ int odhs_stepper_reset(odhs_stepper *st)
     st->ready = 1;
     return ODHS_OK;
 fail:
+    if (psaved) odhs__prop_restore(st->drv);
     if (s < 0) rollback(st);
     st->nchg = 0;
     return s;
@@ -1069,14 +1080,20 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     /* step bookkeeping that rollback() does not cover */
     const uint64_t drv_version0 = st->drv_version, nrejected0 = st->nrejected;
     const double tau0 = st->tau, h0 = st->h;
+    int psaved = 0; /* self-propulsion state saved for the rollback */
     st->nchg = 0;
-    if (st->drv_version != st->drv->version) {
-        /* the driver changed since the forces were solved: re-solve now */
+    if (st->drv_version != st->drv->version || odhs__prop_next(st->drv) <= st->time) {
+        /* the driver changed since the forces were solved (or propulsion
+         * switches are overdue, e.g. on a driver shared by steppers): re-solve */
         if ((s = check_driver(st))) goto fail;
         if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) {
             s = sterr(st, s, "%s", st->drv->errmsg);
             goto fail;
         }
+        odhs__prop_save(st->drv);
+        psaved = 1;
+        odhs__prop_start(st->drv, st->time, st->lambda);
+        odhs__prop_switch(st->drv, st->time, st->lambda);
         if ((s = eval_forces(st)) || (s = rewire(st))) goto fail;
         st->drv_version = st->drv->version;
         if (st->nchg) {
@@ -1087,11 +1104,14 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
             return ODHS_OK;
         }
     }
-    int relocated = 0;
+    int relocated = 0, nhalve = 0;
     if (st->integrator == ODHS_INTEGRATOR_HEUN) {
         memcpy(st->disps, st->disp, st->nd * sizeof *st->disps);
         memcpy(st->Ms, st->M, sizeof st->Ms);
     }
+    /* self-propulsion: a step ends exactly at the next switch time */
+    const double tsw = odhs__prop_next(st->drv), dsw = tsw - st->time;
+    if (dsw <= limit) limit = dsw;
 again:;
     double tplan = st->dt * st->tau;
     if (limit < tplan) tplan = limit;
@@ -1114,6 +1134,17 @@ again:;
     }
     size_t ci, cj;
     double t = predict(st, G, vel, tplan, EPS_V * velocity_scale(st), 1, 1, &ci, &cj);
+    if (st->integrator == ODHS_INTEGRATOR_HEUN && ci != SIZE_MAX && !relocated && t < 1e-3 * tplan &&
+        nhalve < 40 && pair_velocity(st, ci, cj) >= -EPS_V * velocity_scale(st)) {
+        /* a collision at (almost) the start of the step of a pair that
+         * separates with the start velocities: it approaches only on the
+         * averaged chord. Added now, the rewiring would remove it again and
+         * the next step repeat this (no progress): halve the step instead,
+         * until the chord is close enough to the start velocities. */
+        nhalve++;
+        limit = 0.5 * tplan;
+        goto again;
+    }
     advance(st, G, vel, t);
     if (st->net->nwalls) advance_walls(st, t);
     for (size_t k = 0; k < st->nd; ++k)
@@ -1125,7 +1156,8 @@ again:;
         s = sterr(st, ODHS_E_NONFINITE, "the box became degenerate after a step of %g", t);
         goto fail;
     }
-    st->time += t;
+    const int at_switch = ci == SIZE_MAX && t == dsw; /* the step reached the switch time */
+    st->time = at_switch ? tsw : st->time + t;
     st->strain += t * st->drv->gdot;
     st->nsteps++;
     odhs_network *net = st->net;
@@ -1134,7 +1166,10 @@ again:;
          * step with the Heun chord of [0, t_collision] (second order) */
         if ((s = restart_step(st))) goto fail;
         relocated = 1;
-        limit = t * (1.0 + 1e-7);
+        /* at least 1e-3 of the step: over [0, ~1e-17] the chord is the start
+         * velocity, which may close the gap far slower than the averaged
+         * chord did (a Zeno sequence of ~1e-17 steps otherwise) */
+        limit = fmax(t * (1.0 + 1e-7), 1e-3 * tplan);
         goto again;
     }
     if (ci != SIZE_MAX) {
@@ -1157,7 +1192,10 @@ again:;
             for (size_t c = 0; c < net->nc; ++c) fbig = fmax(fbig, fabs(net->f[c]));
             for (size_t c = 0; c < net->nc; ++c) {
                 double f0 = st->sf[c], f1 = net->f[c];
-                if (!odhs__can_open(net->kind[c]) || !(f1 < -EPS_F * fbig) || !(f0 > 0.0)) continue;
+                /* f0 at round-off level: the contact opens now, at the
+                 * step's end (relocating to t f0/(f0 - f1) ~ 1e-16 t would
+                 * repeat forever, as the force stays at round-off) */
+                if (!odhs__can_open(net->kind[c]) || !(f1 < -EPS_F * fbig) || !(f0 > EPS_F * fbig)) continue;
                 tstar = fmin(tstar, t * f0 / (f0 - f1));
             }
             if (tstar < 0.999 * t) {
@@ -1173,6 +1211,13 @@ again:;
             goto fail;
         }
     }
+    if (at_switch) {
+        /* new propulsion forces from the switch time on */
+        if (!psaved) odhs__prop_save(st->drv);
+        psaved = 1;
+        odhs__prop_switch(st->drv, st->time, st->lambda);
+        if ((s = eval_forces(st))) goto fail;
+    }
     if ((s = rewire(st))) goto fail;
     if (!st->jammed && st->corr_every && st->nsteps % st->corr_every == 0) {
         int added = 0;
@@ -1185,6 +1230,7 @@ again:;
                      st->time);
     return ODHS_OK;
 fail:
+    if (psaved) odhs__prop_restore(st->drv);
     rollback(st);
     /* the forces are again those of the start of the step: solved for the
      * driver as it was then (a changed driver is re-solved next time) */

@@ -737,8 +737,10 @@ static void edit_final(af_fix *f, const af_scenario *sc) { check_network(f->net,
 /* -- shear: stepper create, reset, 10 steps, shear reversed (contacts open
  *    at once), 5 steps, shear twice as fast (no event: the step goes on
  *    after re-solving), 5 steps, drift correction; variants: 0 Euler + cg,
- *    1 Heun + dense, 2 Euler + cg at fixed pressure. The driver also carries
- *    (zero) external forces, so that their code paths run too. ------------- */
+ *    1 Heun + dense, 2 Euler + cg at fixed pressure, 3 Heun + dense with
+ *    self-propulsion (short persistence: most steps end at a switch, whose
+ *    redraw a failed step must undo) and gravity with weights. The driver
+ *    also carries (zero) external forces, so that their code paths run too. */
 enum {
     SH_FORCES = 7,
     SH_RESET,
@@ -771,15 +773,24 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
         if (!s && v == 2) s = odhs_driver_set_pressure(f->drv, 0.05);
         return s;
     }
-    case 2: return odhs_solver_create_by_name(v == 1 ? "dense" : "cg", &f->sol);
+    case 2: return odhs_solver_create_by_name(v == 1 || v == 3 ? "dense" : "cg", &f->sol);
     case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
     case 4: return odhs_stepper_set_dt(f->st, 0.02);
-    case 5: return odhs_stepper_set_integrator(f->st, v == 1 ? ODHS_INTEGRATOR_HEUN : ODHS_INTEGRATOR_EULER);
+    case 5:
+        return odhs_stepper_set_integrator(f->st, v == 1 || v == 3 ? ODHS_INTEGRATOR_HEUN : ODHS_INTEGRATOR_EULER);
     case 6: return odhs_stepper_set_contact_tolerance(f->st, 1e-2);
     case SH_FORCES: {
         double F[64];
         memset(F, 0, sizeof F);
-        return odhs_driver_set_forces(f->drv, 32, 2, F);
+        int s = odhs_driver_set_forces(f->drv, 32, 2, F);
+        if (!s && v == 3) {
+            double g[2] = {0.0, -0.3}, w[32];
+            for (int i = 0; i < 32; ++i) w[i] = 1.0 + 0.05 * i;
+            s = odhs_driver_set_self_propulsion(f->drv, 32, 2, 0.5, 1.0, 0.0, 0.5, 9);
+            if (!s) s = odhs_driver_set_gravity(f->drv, 2, g);
+            if (!s) s = odhs_driver_set_gravity_weights(f->drv, 32, w);
+        }
+        return s;
     }
     case SH_RESET: return odhs_stepper_reset(f->st);
     case SH_REVERSE: return odhs_driver_set_shear_rate(f->drv, -1.0);
@@ -792,11 +803,20 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
 
 static void shear_capture(const af_fix *f, const af_scenario *sc, int op, af_buf *b)
 {
-    (void)sc;
     rec_system(b, "sys", f->sys);
     rec_i(b, "handles", (f->drv != NULL) + 2 * (f->sol != NULL));
     rec_stepper(b, f->st);
     if (op < 0) rec(b, "errs", 'd', f->errs, 2);
+    if (sc->variant == 3 && f->drv) {
+        /* the propulsion state: forces, switch times (once started) */
+        double F[64], ts[32];
+        int s = odhs_driver_get_propulsion(f->drv, F, ts);
+        rec_i(b, "prop", s);
+        if (!s) {
+            rec(b, "propF", 'd', F, 64);
+            rec(b, "propT", 'd', ts, 32);
+        }
+    }
 }
 
 /* the network is consistent, the system valid (overlaps below tol, relative
@@ -1190,6 +1210,7 @@ static const af_scenario scenarios[] = {
     {"shear_euler_cg", SH_NOPS, 0, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_heun_dense", SH_NOPS, 1, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_pressure", SH_NOPS, 2, shear_setup, NULL, shear_op, shear_capture, shear_final},
+    {"shear_propulsion", SH_NOPS, 3, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"checkpoint", 3, 0, ckpt_setup, NULL, ckpt_op, ckpt_capture, ckpt_final},

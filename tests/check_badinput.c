@@ -1474,7 +1474,91 @@ static int huge_rate_case(void)
       return odhs_driver_time_unit(w->drv, w->sys2, NULL);)                                                    \
     X(drv_time_unit_unset, odhs_driver_time_unit, ODHS_E_STATE, NOALT, H_DRV, 0,                               \
       double t = 5; int rc = odhs_driver_time_unit(w->drv, w->bare, &t);                                       \
-      return t != 5 ? post("output written") : rc;)
+      return t != 5 ? post("output written") : rc;)                                                            \
+    X(sp_null, odhs_driver_set_self_propulsion, ODHS_E_NULL, NOALT, H_NONE, 0,                                 \
+      return odhs_driver_set_self_propulsion(NULL, 16, 2, 0.5, 1.0, 0.0, 1.0, 1);)                             \
+    X(sp_dim1, odhs_driver_set_self_propulsion, ODHS_E_DIM, NOALT, H_DRV, 0,                                   \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 1, 0.5, 1.0, 0.0, 1.0, 1);)                           \
+    X(sp_dim4, odhs_driver_set_self_propulsion, ODHS_E_DIM, NOALT, H_DRV, 0,                                   \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 4, 0.5, 1.0, 0.0, 1.0, 1);)                           \
+    X(sp_n0, odhs_driver_set_self_propulsion, ODHS_E_EMPTY, NOALT, H_DRV, 0,                                   \
+      return odhs_driver_set_self_propulsion(w->drv, 0, 2, 0.5, 1.0, 0.0, 1.0, 1);)                            \
+    X(sp_fmin_nan, odhs_driver_set_self_propulsion, ODHS_E_NONFINITE, NOALT, H_DRV, 0,                         \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 2, NAN_, 1.0, 0.0, 1.0, 1);)                          \
+    X(sp_tmax_inf, odhs_driver_set_self_propulsion, ODHS_E_NONFINITE, NOALT, H_DRVR, 0,                        \
+      return odhs_driver_set_self_propulsion(w->drvr, 16, 2, 0.5, 1.0, 0.0, INF_, 1);)                         \
+    X(sp_fmax_zero, odhs_driver_set_self_propulsion, ODHS_E_INVALID, NOALT, H_DRV, 0,                          \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 2, 0.0, 0.0, 0.0, 1.0, 1);)                           \
+    X(sp_fmin_negative, odhs_driver_set_self_propulsion, ODHS_E_INVALID, NOALT, H_DRV, 0,                      \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 2, -0.1, 1.0, 0.0, 1.0, 1);)                          \
+    X(sp_fmin_above_fmax, odhs_driver_set_self_propulsion, ODHS_E_INVALID, NOALT, H_DRV, 0,                    \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 2, 2.0, 1.0, 0.0, 1.0, 1);)                           \
+    X(sp_tmax_zero, odhs_driver_set_self_propulsion, ODHS_E_INVALID, NOALT, H_DRV, 0,                          \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 2, 0.5, 1.0, 0.0, 0.0, 1);)                           \
+    X(sp_tmin_negative, odhs_driver_set_self_propulsion, ODHS_E_INVALID, NOALT, H_DRV, 0,                      \
+      return odhs_driver_set_self_propulsion(w->drv, 16, 2, 0.5, 1.0, -1.0, 1.0, 1);)                          \
+    X(sp_tmin_above_tmax, odhs_driver_set_self_propulsion, ODHS_E_INVALID, NOALT, H_DRVR, 0,                   \
+      return odhs_driver_set_self_propulsion(w->drvr, 16, 2, 0.5, 1.0, 3.0, 1.0, 1);)                          \
+    X(sp_wrong_n_for_stepper, odhs_driver_set_self_propulsion, ODHS_E_DIM, NOALT, H_ST, 0,                     \
+      /* propulsion for another N: accepted by the driver, rejected by the stepper */                          \
+      int rc = odhs_driver_set_self_propulsion(w->drv, 12, 2, 0.5, 1.0, 0.0, 1.0, 1);                          \
+      if (rc) return post("set_self_propulsion %d", rc);                                                       \
+      rc = odhs_stepper_reset(w->st); odhs_driver_clear_self_propulsion(w->drv); return rc;)                   \
+    X(sp_wrong_dim_for_running_stepper, odhs_driver_set_self_propulsion, ODHS_E_DIM, NOALT, H_RUN, 0,          \
+      int rc = odhs_driver_set_self_propulsion(w->drvr, 16, 3, 0.5, 1.0, 0.0, 1.0, 1);                         \
+      if (rc) return post("set_self_propulsion %d", rc);                                                       \
+      rc = odhs_stepper_step(w->run, NULL); odhs_driver_clear_self_propulsion(w->drvr); return rc;)            \
+    X(sp_clear_null, odhs_driver_clear_self_propulsion, ODHS_E_NULL, NOALT, H_NONE, 0,                         \
+      return odhs_driver_clear_self_propulsion(NULL);)                                                         \
+    X(sp_clear_off, odhs_driver_clear_self_propulsion, ODHS_OK, NOALT, H_NONE, 0,                              \
+      return odhs_driver_clear_self_propulsion(w->drv);)                                                       \
+    X(sp_get_null, odhs_driver_get_propulsion, ODHS_E_NULL, NOALT, H_NONE, 0,                                  \
+      double F[32]; return odhs_driver_get_propulsion(NULL, F, NULL);)                                         \
+    X(sp_get_null_outputs, odhs_driver_get_propulsion, ODHS_E_NULL, NOALT, H_DRV, 0,                           \
+      return odhs_driver_get_propulsion(w->drv, NULL, NULL);)                                                  \
+    X(sp_get_off, odhs_driver_get_propulsion, ODHS_E_STATE, NOALT, H_DRV, 0,                                   \
+      double F[32] = {0}; F[3] = 7.0; int rc = odhs_driver_get_propulsion(w->drv, F, NULL);                    \
+      return F[3] != 7.0 ? post("output written") : rc;)                                                       \
+    X(sp_get_not_started, odhs_driver_get_propulsion, ODHS_E_STATE, NOALT, H_DRV, 0,                           \
+      /* forces exist at once, switch times only when a stepper starts the clock */                            \
+      double F[32], ts[16] = {0}; ts[0] = 7.0;                                                                 \
+      int rc = odhs_driver_set_self_propulsion(w->drv, 16, 2, 0.5, 1.0, 0.0, 1.0, 1);                          \
+      if (rc) return post("set_self_propulsion %d", rc);                                                       \
+      if ((rc = odhs_driver_get_propulsion(w->drv, F, NULL))) return post("forces: %d", rc);                   \
+      rc = odhs_driver_get_propulsion(w->drv, F, ts);                                                          \
+      odhs_driver_clear_self_propulsion(w->drv);                                                               \
+      return ts[0] != 7.0 ? post("output written") : rc;)                                                      \
+    X(sp_next_null, odhs_driver_next_switch, ODHS_E_NULL, NOALT, H_NONE, 0,                                    \
+      double t; return odhs_driver_next_switch(NULL, &t);)                                                     \
+    X(sp_next_null_out, odhs_driver_next_switch, ODHS_E_NULL, NOALT, H_DRV, 0,                                 \
+      return odhs_driver_next_switch(w->drv, NULL);)                                                           \
+    X(sp_next_off, odhs_driver_next_switch, ODHS_E_STATE, NOALT, H_DRVR, 0,                                    \
+      double t = 5; int rc = odhs_driver_next_switch(w->drvr, &t);                                             \
+      return t != 5 ? post("output written") : rc;)                                                            \
+    X(grav_null, odhs_driver_set_gravity, ODHS_E_NULL, NOALT, H_NONE, 0,                                       \
+      double g[2] = {0, -1}; return odhs_driver_set_gravity(NULL, 2, g);)                                      \
+    X(grav_dim1, odhs_driver_set_gravity, ODHS_E_DIM, NOALT, H_DRV, 0,                                         \
+      double g[2] = {0, -1}; return odhs_driver_set_gravity(w->drv, 1, g);)                                    \
+    X(grav_nan, odhs_driver_set_gravity, ODHS_E_NONFINITE, NOALT, H_DRV, 0,                                    \
+      double g[3] = {0, -1, NAN_}; return odhs_driver_set_gravity(w->drv, 3, g);)                              \
+    X(grav_remove_none, odhs_driver_set_gravity, ODHS_OK, NOALT, H_NONE, 0,                                    \
+      return odhs_driver_set_gravity(w->drv, 2, NULL);)                                                        \
+    X(grav_wrong_dim_for_stepper, odhs_driver_set_gravity, ODHS_E_DIM, NOALT, H_RUN, 0,                        \
+      double g[3] = {0, -1, 0}; int rc = odhs_driver_set_gravity(w->drvr, 3, g);                               \
+      if (rc) return post("set_gravity %d", rc);                                                               \
+      rc = odhs_stepper_step(w->run, NULL); odhs_driver_set_gravity(w->drvr, 3, NULL); return rc;)             \
+    X(gw_null, odhs_driver_set_gravity_weights, ODHS_E_NULL, NOALT, H_NONE, 0,                                 \
+      double wt[16] = {0}; return odhs_driver_set_gravity_weights(NULL, 16, wt);)                              \
+    X(gw_n0, odhs_driver_set_gravity_weights, ODHS_E_EMPTY, NOALT, H_DRV, 0,                                   \
+      double wt[1] = {1}; return odhs_driver_set_gravity_weights(w->drv, 0, wt);)                              \
+    X(gw_nan, odhs_driver_set_gravity_weights, ODHS_E_NONFINITE, NOALT, H_DRVR, 0,                             \
+      double wt[16] = {0}; wt[9] = NAN_; return odhs_driver_set_gravity_weights(w->drvr, 16, wt);)             \
+    X(gw_wrong_n_for_stepper, odhs_driver_set_gravity_weights, ODHS_E_DIM, NOALT, H_ST, 0,                     \
+      double g[2] = {0, -1}, wt[12] = {0}; int rc = odhs_driver_set_gravity(w->drv, 2, g);                     \
+      if (!rc) rc = odhs_driver_set_gravity_weights(w->drv, 12, wt);                                           \
+      if (rc) return post("set gravity %d", rc);                                                               \
+      rc = odhs_stepper_reset(w->st); odhs_driver_set_gravity(w->drv, 2, NULL);                                \
+      odhs_driver_set_gravity_weights(w->drv, 0, NULL); return rc;)
 
 /* ---- stepper.h ----------------------------------------------------------------- */
 #define STEPPER_OBS(X, id, fn, T, n)                                                                           \

@@ -87,8 +87,15 @@ static void grab(odhs_stepper *st, odhs_system *sys, state *s)
     odhs_stepper_counts(st, &s->steps, &s->ncoll, &s->nopen);
 }
 
-static void run_and_compare(int dim, int integrator, const char *solver, int pressure)
+/* flags for run_and_compare */
+#define RC_PRESSURE 1
+#define RC_PROPULSION 2
+#define RC_GRAVITY 4
+#define RC_NOSHEAR 8
+
+static void run_and_compare(int dim, int integrator, const char *solver, int flags)
 {
+    int pressure = flags & RC_PRESSURE;
     odhs_system *base = scene(dim, dim == 2 ? 48 : 40, dim == 2 ? 0.74 : 0.5, 9);
     char path[128];
     snprintf(path, sizeof path, "%s/run.ckpt", dir);
@@ -100,8 +107,19 @@ static void run_and_compare(int dim, int integrator, const char *solver, int pre
     ck_assert_int_eq(odhs_system_clone(base, &sa), ODHS_OK);
     ck_assert_int_eq(odhs_solver_create_by_name(solver, &sol), ODHS_OK);
     ck_assert_int_eq(odhs_driver_create(&da), ODHS_OK);
-    ck_assert_int_eq(odhs_driver_set_shear_rate(da, 1.0), ODHS_OK);
+    if (!(flags & RC_NOSHEAR)) ck_assert_int_eq(odhs_driver_set_shear_rate(da, 1.0), ODHS_OK);
     if (pressure) ck_assert_int_eq(odhs_driver_set_pressure(da, 2.0), ODHS_OK);
+    size_t np = odhs_system_count(sa);
+    /* short persistence: many switches inside the 120 steps */
+    if (flags & RC_PROPULSION)
+        ck_assert_int_eq(odhs_driver_set_self_propulsion(da, np, dim, 0.5, 1.5, 0.0, 0.05, 17), ODHS_OK);
+    if (flags & RC_GRAVITY) {
+        double g[3] = {0.1, -0.4, 0.2}, *wt = malloc(np * sizeof *wt);
+        ck_assert_int_eq(odhs_driver_set_gravity(da, dim, g), ODHS_OK);
+        for (size_t i = 0; i < np; ++i) wt[i] = 1.0 + 0.25 * (double)(i % 3);
+        if (flags & RC_PROPULSION) ck_assert_int_eq(odhs_driver_set_gravity_weights(da, np, wt), ODHS_OK);
+        free(wt);
+    }
     ck_assert_int_eq(odhs_stepper_create(sa, da, sol, &a), ODHS_OK);
     ck_assert_int_eq(odhs_stepper_set_integrator(a, integrator), ODHS_OK);
     ck_assert_int_eq(odhs_stepper_set_correction_interval(a, 7), ODHS_OK);
@@ -124,6 +142,9 @@ static void run_and_compare(int dim, int integrator, const char *solver, int pre
     for (int k = 0; k < 60; ++k) ck_assert_int_eq(odhs_stepper_step(b, NULL), ODHS_OK);
     state B;
     grab(b, sb, &B);
+    odhs_system *sb2;
+    odhs_driver *db2;
+    odhs_stepper *b2;
     size_t nd = odhs_system_count(sa) * (size_t)dim;
     ck_assert_msg(!memcmp(A.x, B.x, nd * sizeof *A.x), "positions differ after restore");
     ck_assert_uint_eq(A.nc, B.nc);
@@ -136,6 +157,33 @@ static void run_and_compare(int dim, int integrator, const char *solver, int pre
         ck_assert(la->i[mark + e] == lb->i[e] && la->j[mark + e] == lb->j[e] && la->kind[mark + e] == lb->kind[e]);
     }
     ck_assert_msg(lb->n > 0, "no events in the second half: the test would not exercise rewiring");
+    if (flags & RC_PROPULSION) {
+        /* the propulsion state (forces, switch times, random numbers) too */
+        size_t np = odhs_system_count(sa);
+        double *Fa = malloc(nd * sizeof *Fa), *Fb = malloc(nd * sizeof *Fb);
+        double *ta = malloc(np * sizeof *ta), *tb = malloc(np * sizeof *tb);
+        ck_assert_int_eq(odhs_driver_get_propulsion(da, Fa, ta), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_get_propulsion(db, Fb, tb), ODHS_OK);
+        ck_assert(!memcmp(Fa, Fb, nd * sizeof *Fa) && !memcmp(ta, tb, np * sizeof *ta));
+        /* and it switched during the compared half */
+        ck_assert(ta[0] > 0.0);
+        double t0;
+        ck_assert_int_eq(odhs_checkpoint_read(path, sol, &sb2, &db2, &b2, NULL, 0), ODHS_OK);
+        odhs_stepper_time(b2, &t0);
+        double *t2 = malloc(np * sizeof *t2);
+        ck_assert_int_eq(odhs_driver_get_propulsion(db2, NULL, t2), ODHS_OK);
+        size_t switched = 0;
+        for (size_t i = 0; i < np; ++i) switched += t2[i] != tb[i];
+        ck_assert_uint_gt(switched, np / 4);
+        free(t2);
+        odhs_stepper_destroy(b2);
+        odhs_driver_destroy(db2);
+        odhs_system_destroy(sb2);
+        free(Fa);
+        free(Fb);
+        free(ta);
+        free(tb);
+    }
     free(A.x);
     free(A.f);
     free(B.x);
@@ -160,9 +208,23 @@ START_TEST(test_bit_identical_pressure_2d) { run_and_compare(2, ODHS_INTEGRATOR_
 END_TEST
 START_TEST(test_bit_identical_3d) { run_and_compare(3, ODHS_INTEGRATOR_EULER, "cg", 0); }
 END_TEST
+START_TEST(test_bit_identical_propulsion_2d) { run_and_compare(2, ODHS_INTEGRATOR_EULER, "cg", RC_PROPULSION); }
+END_TEST
+START_TEST(test_bit_identical_propulsion_gravity_heun_2d)
+{
+    run_and_compare(2, ODHS_INTEGRATOR_HEUN, "dense", RC_PROPULSION | RC_GRAVITY | RC_NOSHEAR);
+}
+END_TEST
+START_TEST(test_bit_identical_propulsion_3d)
+{
+    run_and_compare(3, ODHS_INTEGRATOR_EULER, "dense", RC_PROPULSION | RC_NOSHEAR);
+}
+END_TEST
+START_TEST(test_bit_identical_gravity_shear_2d) { run_and_compare(2, ODHS_INTEGRATOR_EULER, "dense", RC_GRAVITY); }
+END_TEST
 
 /* a small valid checkpoint in memory */
-static unsigned char *make_ckpt(size_t *len, odhs_solver **solp)
+static unsigned char *make_ckpt_ex(size_t *len, odhs_solver **solp, int propulsion)
 {
     odhs_system *sys = scene(2, 16, 0.6, 3);
     odhs_solver *sol;
@@ -174,6 +236,13 @@ static unsigned char *make_ckpt(size_t *len, odhs_solver **solp)
     ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
     ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 1.0), ODHS_OK);
     ck_assert_int_eq(odhs_driver_set_forces(drv, 16, 2, F), ODHS_OK);
+    if (propulsion) {
+        double g[2] = {0.0, -0.3}, wt[16];
+        for (int k = 0; k < 16; ++k) wt[k] = 1.0 + 0.1 * k;
+        ck_assert_int_eq(odhs_driver_set_self_propulsion(drv, 16, 2, 0.1, 0.2, 0.0, 1.0, 5), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_set_gravity(drv, 2, g), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_set_gravity_weights(drv, 16, wt), ODHS_OK);
+    }
     ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
     for (int k = 0; k < 10; ++k) ck_assert_int_eq(odhs_stepper_step(st, NULL), ODHS_OK);
     char path[128];
@@ -190,6 +259,97 @@ static unsigned char *make_ckpt(size_t *len, odhs_solver **solp)
     *solp = sol;
     return buf;
 }
+
+static unsigned char *make_ckpt(size_t *len, odhs_solver **solp) { return make_ckpt_ex(len, solp, 0); }
+
+static uint64_t fnv1a(const unsigned char *p, size_t len)
+{
+    uint64_t h = 1469598103934665603ULL;
+    for (size_t k = 0; k < len; ++k) {
+        h ^= p[k];
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+/* little-endian u64 at p */
+static uint64_t rd64(const unsigned char *p)
+{
+    uint64_t v = 0;
+    for (int k = 7; k >= 0; --k) v = (v << 8) | p[k];
+    return v;
+}
+
+static void wr64(unsigned char *p, uint64_t v)
+{
+    for (int k = 0; k < 8; ++k) p[k] = (unsigned char)(v >> (8 * k));
+}
+
+/* set the version field and fix the checksum */
+static void set_version(unsigned char *buf, size_t len, uint64_t v)
+{
+    wr64(buf + 8, v);
+    wr64(buf + len - 8, fnv1a(buf, len - 8));
+}
+
+START_TEST(test_versions)
+{
+    /* without propulsion or gravity the file is version 1 (what older
+     * releases read); with them, version 2 */
+    size_t len1, len2;
+    odhs_solver *sol1, *sol2;
+    unsigned char *b1 = make_ckpt_ex(&len1, &sol1, 0), *b2 = make_ckpt_ex(&len2, &sol2, 1);
+    ck_assert_uint_eq(rd64(b1 + 8), 1);
+    ck_assert_uint_eq(rd64(b2 + 8), 2);
+    ck_assert_int_eq(ODHS_CHECKPOINT_VERSION, 2);
+    odhs_system *s;
+    odhs_driver *d;
+    odhs_stepper *st;
+    char err[256];
+    /* a version-1 file read as version 2 (same sections) loads */
+    set_version(b1, len1, 2);
+    ck_assert_int_eq(odhs_checkpoint_parse(b1, len1, sol1, &s, &d, &st, err, sizeof err), ODHS_OK);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(d);
+    odhs_system_destroy(s);
+    /* version-2 sections in a file that claims version 1: rejected */
+    set_version(b2, len2, 1);
+    ck_assert_int_eq(odhs_checkpoint_parse(b2, len2, sol2, &s, &d, &st, err, sizeof err), ODHS_E_FORMAT);
+    ck_assert(s == NULL && d == NULL && st == NULL);
+    /* a future version: rejected */
+    set_version(b2, len2, 3);
+    ck_assert_int_eq(odhs_checkpoint_parse(b2, len2, sol2, &s, &d, &st, err, sizeof err), ODHS_E_FORMAT);
+    ck_assert(strstr(err, "version") != NULL);
+    set_version(b2, len2, 2);
+    ck_assert_int_eq(odhs_checkpoint_parse(b2, len2, sol2, &s, &d, &st, err, sizeof err), ODHS_OK);
+    /* the propulsion and gravity settings came back */
+    double F[32], ts[16], tn;
+    ck_assert_int_eq(odhs_driver_get_propulsion(d, F, ts), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_next_switch(d, &tn), ODHS_OK);
+    for (int i = 0; i < 16; ++i) {
+        ck_assert(ts[i] >= tn);
+        double m = hypot(F[2 * i], F[2 * i + 1]);
+        ck_assert(m >= 0.1 * (1 - 1e-15) && m <= 0.2 * (1 + 1e-15));
+    }
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(d);
+    odhs_system_destroy(s);
+    /* every truncation and single-byte corruption of a version-2 file fails */
+    for (size_t cut = 0; cut < len2; cut += 41) {
+        ck_assert_int_eq(odhs_checkpoint_parse(b2, cut, sol2, &s, &d, &st, err, sizeof err), ODHS_E_FORMAT);
+        ck_assert(s == NULL && d == NULL && st == NULL);
+    }
+    for (size_t k = 0; k < len2; k += 29) {
+        b2[k] ^= 0x21;
+        ck_assert_int_eq(odhs_checkpoint_parse(b2, len2, sol2, &s, &d, &st, err, sizeof err), ODHS_E_FORMAT);
+        b2[k] ^= 0x21;
+    }
+    free(b1);
+    free(b2);
+    odhs_solver_destroy(sol1);
+    odhs_solver_destroy(sol2);
+}
+END_TEST
 
 START_TEST(test_truncated_and_corrupted)
 {
@@ -288,6 +448,11 @@ Suite *make_checkpoint_suite(void)
     tcase_add_test(tc, test_bit_identical_heun_2d);
     tcase_add_test(tc, test_bit_identical_pressure_2d);
     tcase_add_test(tc, test_bit_identical_3d);
+    tcase_add_test(tc, test_bit_identical_propulsion_2d);
+    tcase_add_test(tc, test_bit_identical_propulsion_gravity_heun_2d);
+    tcase_add_test(tc, test_bit_identical_propulsion_3d);
+    tcase_add_test(tc, test_bit_identical_gravity_shear_2d);
+    tcase_add_test(tc, test_versions);
     tcase_add_test(tc, test_truncated_and_corrupted);
     tcase_add_test(tc, test_atomic_write);
     suite_add_tcase(s, tc);

@@ -18,7 +18,7 @@ expect() { # expect CODE DESCRIPTION -- command...
 expect_in() { # expect_in FILE PATTERN DESCRIPTION
     if grep -q -- "$2" "$tmp/$1"; then pass=$((pass + 1)); else echo "FAIL: $3"; fail=$((fail + 1)); fi
 }
-for prog in shear_flow compress; do
+for prog in shear_flow compress self_propulsion; do
     expect 0 "$prog --help" -- "$bin/$prog" --help
     expect_in out "usage: $prog" "$prog --help prints usage"
     expect 2 "$prog unknown option" -- "$bin/$prog" --no-such-option
@@ -41,11 +41,25 @@ expect 0 "shear_flow from a file" -- "$bin/shear_flow" --in "$tmp/c.xyz" --strai
 expect_in s.csv "^strain,shear_stress,pressure,z,events" "shear_flow writes its series header"
 [ "$(wc -l < "$tmp/s.csv")" -eq 4 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow series rows"; fail=$((fail + 1)); }
 expect 0 "shear_flow at fixed pressure" -- "$bin/shear_flow" --in "$tmp/s.xyz" --strain 0.01 --pressure 5
+expect 0 "shear_flow svg" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --svg "$tmp/s.svg"
+head -c 4 "$tmp/s.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: shear_flow svg"; fail=$((fail + 1)); }
+grep -q "<line" "$tmp/s.svg" && pass=$((pass + 1)) || { echo "FAIL: shear_flow svg has no force lines"; fail=$((fail + 1)); }
 expect 0 "shear_flow 3D built-in" -- "$bin/shear_flow" --dim 3 --n 32 --phi 0.4 --strain 0.01
 expect 0 "shear_flow dense solver" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --solver dense
 expect 0 "shear_flow adaptive" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --integrator heun --tol 1e-8
 expect 2 "shear_flow bad integrator" -- "$bin/shear_flow" --integrator rk9
 expect 2 "shear_flow bad tol" -- "$bin/shear_flow" --tol 2
+expect 0 "self_propulsion built-in" -- "$bin/self_propulsion" --n 64 --time 2 --every 1 --series "$tmp/p.csv" \
+    --svg "$tmp/p.svg" --out "$tmp/p.xyz"
+expect_in p.csv "^time,mean_speed,pressure,z,collisions,openings" "self_propulsion writes its series header"
+[ "$(wc -l < "$tmp/p.csv")" -eq 4 ] && pass=$((pass + 1)) || { echo "FAIL: self_propulsion series rows"; fail=$((fail + 1)); }
+head -c 4 "$tmp/p.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: self_propulsion svg"; fail=$((fail + 1)); }
+grep -q 'marker-end="url(#head)"' "$tmp/p.svg" && pass=$((pass + 1)) || { echo "FAIL: self_propulsion svg arrows"; fail=$((fail + 1)); }
+expect 0 "self_propulsion from a file" -- "$bin/self_propulsion" --in "$tmp/p.xyz" --time 0.5 --tmax 2
+expect 0 "self_propulsion 3D" -- "$bin/self_propulsion" --dim 3 --n 32 --phi 0.3 --time 0.5
+expect 2 "self_propulsion bad tmax" -- "$bin/self_propulsion" --tmax 0
+expect 2 "self_propulsion bad time" -- "$bin/self_propulsion" --time -1
+expect 2 "self_propulsion bad phi" -- "$bin/self_propulsion" --phi 1.5
 expect 0 "jam_packing help" -- "$bin/jam_packing" --help
 expect 2 "jam_packing bad protocol" -- "$bin/jam_packing" --protocol squash
 expect 0 "jam_packing compress" -- "$bin/jam_packing" --n 32 --svg "$tmp/j.svg" --contacts "$tmp/j.con" --out "$tmp/j.xyz"

@@ -3,7 +3,8 @@
  *
  * A checkpoint holds everything a stepper needs to continue exactly as if it
  * had not stopped: the system (positions, radii, species, box, strain), the
- * driver settings (mobility, rates, pressure, fixed forces), the stepper's
+ * driver settings (mobility, rates, pressure, fixed forces, gravity,
+ * self-propulsion with its random-number state), the stepper's
  * settings and state (time, strain, counters, integrator and adaptive step,
  * the contact network in its order with its forces, velocities, neighbour
  * list and its bookkeeping). Continuing from a checkpoint is bit-identical to
@@ -11,11 +12,18 @@
  * Not saved (they are code, not data): force and event callbacks, and the
  * solver itself: set them again on the restored handles.
  *
- * Format (version 1): little-endian binary; magic "ODHSCKPT", a format
- * version, then tagged sections, then a 64-bit FNV-1a checksum of all
- * preceding bytes. Writes go to a temporary file in the same directory that is
- * flushed, synced and renamed over the target, so a crash mid-write leaves any
- * previous checkpoint intact. A truncated, corrupted or foreign file gives
+ * Format: little-endian binary; magic "ODHSCKPT", a format version, then
+ * tagged sections, then a 64-bit FNV-1a checksum of all preceding bytes.
+ * Version 1: sections SYS, DRV, STP, NET. Version 2 adds optional sections:
+ * WAL before NET (hard walls: shape, position, velocity, displacement), and
+ * after NET, each at most once, CMP (rest lengths of bonds, rigid-body
+ * labels), PROP (self-propulsion: settings, whether its clock runs, the
+ * xoshiro256** state, current forces and switch times) and GRAV (gravity
+ * field and weights). A checkpoint that needs none of them is still written
+ * as version 1, so older releases read it; this library reads both.
+ * Writes go to a temporary file in the same directory that is flushed, synced
+ * and renamed over the target, so a crash mid-write leaves any previous
+ * checkpoint intact. A truncated, corrupted or foreign file gives
  * ODHS_E_FORMAT and no handle.
  */
 #ifndef ODHS_CHECKPOINT_H
@@ -28,7 +36,7 @@ extern "C" {
 #endif
 
 /** Current checkpoint format version. */
-#define ODHS_CHECKPOINT_VERSION 1
+#define ODHS_CHECKPOINT_VERSION 2
 
 /**
  * Save the stepper's simulation to path (atomically). The stepper must be

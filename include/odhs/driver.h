@@ -24,6 +24,38 @@
  * a flow is set; otherwise lambda / (xi0 f_rms) for fixed forces, with lambda
  * the mean diameter and f_rms = sqrt(<F|F>/N); otherwise the value set with
  * odhs_driver_set_time_unit (default: lambda / xi0, i.e. unit force).
+ * With self-propulsion and/or gravity the force scale is
+ *     f_ext^2 = <F_d|F_d>/N + <|F_p|^2>,
+ * F_d the deterministic forces (fixed forces plus gravity), <|F_p|^2> =
+ * (fmin^2 + fmin fmax + fmax^2)/3 the mean square propulsion force (its
+ * expectation, so tau does not jump when forces are redrawn); with fixed
+ * forces alone this is the f_rms above.
+ *
+ * Self-propulsion (Sect. V B of the paper): particle i carries a propulsion
+ * force F_i of magnitude uniform in [fmin, fmax] and direction uniform on the
+ * circle (2D) or sphere (3D), held for a persistence time uniform in
+ * [tmin, tmax] tau_p, after which a new force and a new persistence time are
+ * drawn. tau_p = lambda / (xi0 f_p) with f_p = sqrt(<|F_p|^2>) is the paper's
+ * tau = lambda/(f_ext xi0), f_ext = sqrt(<F_ext|F_ext>/N) (the paper prints
+ * the /N outside the square root: a typo, f_ext must scale like one force).
+ * Random numbers come from xoshiro256** seeded with the given seed and kept in
+ * the driver, so a run is reproducible bit for bit. The stepper ends a step
+ * exactly at every switch time, so the sequence of forces and switch times
+ * does not depend on the step size, the integrator or the dynamics; a switch
+ * that makes contact forces negative shows up as openings at the switch time.
+ * Drawing order: at setting time, for i = 0..N-1 the force of i (2D: angle,
+ * magnitude; 3D: cos(theta), azimuth, magnitude) then its persistence; at a
+ * switch time t the particles due, in index order, the same way.
+ * The clock starts when a stepper first takes the setting (its reset or next
+ * step): switch times are then t0 + persistence * tau_p, t0 the stepper's
+ * time; later persistence times use the tau_p (xi0) current when drawn. A driver with self-propulsion follows the clock of one stepper; share
+ * it between steppers only if they run in lock step.
+ *
+ * Gravity: a uniform field g adds F_i = w_i g to every particle, with weight
+ * w_i = (a_i / <a>)^d (mass proportional to the volume, <a> the mean radius;
+ * a particle of mean size carries g) or weights set by the user.
+ *
+ * Fixed forces (or the callback), self-propulsion and gravity add up.
  */
 #ifndef ODHS_DRIVER_H
 #define ODHS_DRIVER_H
@@ -74,6 +106,47 @@ ODHS_API int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const d
 ODHS_API int odhs_driver_set_force_callback(odhs_driver *drv, odhs_force_fn fn, void *ctx);
 /** Natural time unit for callback-driven runs (> 0). */
 ODHS_API int odhs_driver_set_time_unit(odhs_driver *drv, double tau);
+
+/**
+ * Self-propulsion for n particles in dimension dim (see above): magnitudes
+ * uniform in [fmin, fmax] (0 <= fmin <= fmax, fmax > 0; fmin = fmax gives a
+ * fixed magnitude), persistence times uniform in [tmin, tmax] in units of
+ * tau_p (0 <= tmin <= tmax, tmax > 0), random numbers from seed. Draws the
+ * initial forces and persistence times now (they can be read with
+ * odhs_driver_get_propulsion before any step); replaces earlier propulsion
+ * settings and restarts the clock. Errors: ODHS_E_NULL, ODHS_E_DIM,
+ * ODHS_E_EMPTY (n = 0), ODHS_E_NONFINITE, ODHS_E_INVALID, ODHS_E_NOMEM.
+ */
+ODHS_API int odhs_driver_set_self_propulsion(odhs_driver *drv, size_t n, int dim, double fmin, double fmax,
+                                             double tmin, double tmax, uint64_t seed);
+/** Turn self-propulsion off (no-op when it is off). */
+ODHS_API int odhs_driver_clear_self_propulsion(odhs_driver *drv);
+/**
+ * Current propulsion forces F[0..n*dim-1] and next switch times
+ * tswitch[0..n-1] (absolute, in the stepper's time); either may be NULL.
+ * Errors: ODHS_E_NULL (drv, or both outputs NULL), ODHS_E_STATE (propulsion
+ * off; or tswitch requested before a stepper started the clock), with the
+ * outputs untouched.
+ */
+ODHS_API int odhs_driver_get_propulsion(const odhs_driver *drv, double *F, double *tswitch);
+/**
+ * Earliest switch time of the propulsion forces (the stepper ends a step
+ * there). Errors: ODHS_E_NULL, ODHS_E_STATE (propulsion off or its clock not
+ * started yet).
+ */
+ODHS_API int odhs_driver_next_switch(const odhs_driver *drv, double *t);
+/**
+ * Uniform gravity field g[0..dim-1] (copied); g == NULL removes it.
+ * F_i = w_i g, w_i = (a_i/<a>)^dim unless weights are set.
+ * Errors: ODHS_E_NULL, ODHS_E_DIM, ODHS_E_NONFINITE.
+ */
+ODHS_API int odhs_driver_set_gravity(odhs_driver *drv, int dim, const double *g);
+/**
+ * Per-particle gravity weights w[0..n-1] (finite, any sign: a negative weight
+ * is a buoyant particle); w == NULL restores the volume weights (a_i/<a>)^d.
+ * Errors: ODHS_E_NULL, ODHS_E_EMPTY (n = 0), ODHS_E_NONFINITE, ODHS_E_NOMEM.
+ */
+ODHS_API int odhs_driver_set_gravity_weights(odhs_driver *drv, size_t n, const double *w);
 
 /** Getters. */
 ODHS_API int odhs_driver_get_shear_rate(const odhs_driver *drv, double *gammadot);

@@ -26,7 +26,8 @@
  * resolution is the step dt*tau (Sect. IV A (ii.b) of the paper). A change of
  * the driver between steps is applied at the start of the next step; if it
  * opens or closes contacts, that step ends at once with those events and no
- * motion.
+ * motion. With self-propulsion (driver.h) a step also ends exactly at every
+ * switch time of a propulsion force, and the new forces act from there.
  */
 #ifndef ODHS_STEPPER_H
 #define ODHS_STEPPER_H
