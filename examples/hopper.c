@@ -27,7 +27,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: hopper [options]\n"
-            "  --n N              number of discs (default 300)\n"
+            "  --n N              number of discs (default 300; radii 0.5 and 0.7 +-5%%)\n"
             "  --outlet D         outlet width in small diameters (default 3.2)\n"
             "  --width W          box width (default 24)\n"
             "  --time T           longest run, in units of tau (default 400)\n"
@@ -176,13 +176,15 @@ int main(int argc, char **argv)
     double area = 0.0;
     double *r = malloc(n * sizeof *r), *x = malloc(2 * n * sizeof *x), *F = malloc(2 * n * sizeof *F);
     if (!r || !x || !F) return 1;
+    /* 5% polydispersity: identical discs sliding in lockstep along a wall
+     * would form exactly degenerate (redundant) contact geometries */
+    srand((unsigned)seed);
     for (size_t i = 0; i < n; ++i) {
-        r[i] = i % 2 ? 0.7 : 0.5;
+        r[i] = (i % 2 ? 0.7 : 0.5) * (1.0 + 0.05 * (2.0 * rand() / ((double)RAND_MAX + 1.0) - 1.0));
         area += 3.14159265358979323846 * r[i] * r[i];
     }
     double ystart = ytop + 1.0, hfill = 2.2 * area / width + 4.0;
     double L[2] = {width, ystart + hfill + 4.0 + yout};
-    srand((unsigned)seed);
     for (size_t i = 0; i < n; ++i) {
         int ok = 0;
         for (int tries = 0; tries < 100000 && !ok; ++tries) {

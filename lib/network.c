@@ -440,7 +440,7 @@ void odhs__net_geometry(odhs_network *net, const odhs_system *sys)
     for (size_t c = 0; c < net->nc; ++c) {
         size_t i = net->ci[c], j = net->cj[c];
         if (j >= net->n) {
-            double r = odhs__wall_geom(&net->walls[j - net->n], d, sys->x + i * d, net->nrm + c * d);
+            double r = odhs__wall_geom(&net->walls[j - net->n], d, sys->L, sys->gamma, sys->x + i * d, net->nrm + c * d, NULL);
             net->dist[c] = r;
             net->gap[c] = r - sys->r[i];
             continue;
@@ -496,6 +496,22 @@ static int detect_cb(size_t i, size_t j, const double *rij, double gap, void *vc
     return 0;
 }
 
+/* particle i already touches another wall with this normal (two segments
+ * sharing an end): a second contact there would be redundant */
+static int same_normal_wall(const odhs_network *net, const odhs_system *sys, size_t i, size_t w, const double *nw)
+{
+    int d = net->dim;
+    for (uint32_t k = 0; k < net->adjn[i]; ++k) {
+        size_t o = net->adj[i][k];
+        if (o < net->n || o - net->n == w) continue;
+        double no[3], dot = 0.0;
+        odhs__wall_geom(&net->walls[o - net->n], d, sys->L, sys->gamma, sys->x + i * d, no, NULL);
+        for (int a = 0; a < d; ++a) dot += nw[a] * no[a];
+        if (dot > 1.0 - 1e-9) return 1;
+    }
+    return 0;
+}
+
 int odhs_network_detect(odhs_network *net, const odhs_system *sys, double tol)
 {
     if (!net) return ODHS_E_NULL;
@@ -515,8 +531,9 @@ int odhs_network_detect(odhs_network *net, const odhs_system *sys, double tol)
     for (size_t w = 0; w < net->nwalls; ++w)
         for (size_t i = 0; i < sys->n; ++i) {
             double nrm[3];
-            double g = odhs__wall_geom(&net->walls[w], sys->dim, sys->x + i * sys->dim, nrm) - sys->r[i];
+            double g = odhs__wall_geom(&net->walls[w], sys->dim, sys->L, sys->gamma, sys->x + i * sys->dim, nrm, NULL) - sys->r[i];
             if (g <= tol * 2.0 * sys->r[i] && odhs__net_find(net, i, sys->n + w) == SIZE_MAX &&
+                !same_normal_wall(net, sys, i, w, nrm) &&
                 odhs__net_add(net, i, sys->n + w, ODHS_CONTACT_WALL) == SIZE_MAX) {
                 while (net->nc > nc0) odhs__net_remove_at(net, net->nc - 1);
                 return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");

@@ -230,9 +230,9 @@ static double pair_velocity(const odhs_stepper *st, size_t i, size_t j)
     double d[3], gd[3];
     if (j >= st->n) { /* a wall: rate of the gap, n.(v_wall - V_i) */
         const odhs_wall *w = &st->net->walls[j - st->n];
-        double nrm[3], gx[3], v = 0.0;
-        odhs__wall_geom(w, dim, st->sys->x + i * dim, nrm);
-        apply_G(st->G, dim, st->sys->x + i * dim, gx);
+        double nrm[3], gx[3], xi[3], v = 0.0;
+        odhs__wall_geom(w, dim, st->sys->L, st->sys->gamma, st->sys->x + i * dim, nrm, xi);
+        apply_G(st->G, dim, xi, gx);
         for (int k = 0; k < dim; ++k) v += nrm[k] * (w->v[k] - gx[k] - st->U[i * dim + k]);
         return v;
     }
@@ -249,7 +249,8 @@ static void contact_geometry(odhs_stepper *st, size_t c)
     int dim = st->dim;
     if (net->cj[c] >= st->n) {
         size_t i = net->ci[c];
-        double r = odhs__wall_geom(&net->walls[net->cj[c] - st->n], dim, st->sys->x + i * dim, net->nrm + c * dim);
+        double r = odhs__wall_geom(&net->walls[net->cj[c] - st->n], dim, st->sys->L, st->sys->gamma, st->sys->x + i * dim,
+                                   net->nrm + c * dim, NULL);
         net->dist[c] = r;
         net->gap[c] = r - st->sys->r[i];
         net->version++;
@@ -503,6 +504,28 @@ static double predict(const odhs_stepper *st, const double *G, const double *vel
 /* earliest time in [0, best) at which a particle not in contact with a wall
  * touches it, moving as x + t (G x + vel) against walls translating with their
  * velocities (moving = 1) or at rest (moving = 0, the drift correction) */
+/* Whether particle i would meet wall w at a point where it already touches
+ * another wall with the same normal (two segments sharing an end): that
+ * constraint is already in the network, and a second copy would make N
+ * singular. x is the particle's image near w, moving with u, at time t. */
+static int corner_duplicate(const odhs_stepper *st, size_t i, size_t w, const double *x, const double *u, double t)
+{
+    const odhs_network *net = st->net;
+    int dim = st->dim;
+    double y[3] = {0, 0, 0}, nw[3], no[3];
+    for (uint32_t k = 0; k < net->adjn[i]; ++k) {
+        size_t o = net->adj[i][k];
+        if (o < st->n || o - st->n == w) continue;
+        for (int a = 0; a < dim; ++a) y[a] = x[a] + t * u[a];
+        odhs__wall_geom(&net->walls[w], dim, st->sys->L, st->sys->gamma, y, nw, NULL);
+        odhs__wall_geom(&net->walls[o - st->n], dim, st->sys->L, st->sys->gamma, y, no, NULL);
+        double dot = 0.0;
+        for (int a = 0; a < dim; ++a) dot += nw[a] * no[a];
+        if (dot > 1.0 - 1e-9) return 1;
+    }
+    return 0;
+}
+
 static double predict_walls(const odhs_stepper *st, const double *G, const double *vel, double best, double vtol,
                             int moving, int current, size_t *pi, size_t *pj)
 {
@@ -513,11 +536,11 @@ static double predict_walls(const odhs_stepper *st, const double *G, const doubl
     for (size_t w = 0; w < net->nwalls; ++w) {
         const odhs_wall *wl = &net->walls[w];
         for (size_t i = 0; i < st->n; ++i) {
-            const double *x = s->x + i * dim;
+            double x[3] = {0, 0, 0};
             double a = s->r[i], u[3] = {0, 0, 0}, nrm[3] = {0, 0, 0}, gx[3];
+            double g0 = odhs__wall_geom(wl, dim, s->L, s->gamma, s->x + i * dim, nrm, x) - a, un = 0.0, uu = 0.0;
             apply_G(G, dim, x, gx);
             for (int k = 0; k < dim; ++k) u[k] = gx[k] + vel[i * dim + k] - (moving ? wl->v[k] : 0.0);
-            double g0 = odhs__wall_geom(wl, dim, x, nrm) - a, un = 0.0, uu = 0.0;
             for (int k = 0; k < dim; ++k) {
                 un += nrm[k] * u[k]; /* > 0: approaching */
                 uu += u[k] * u[k];
@@ -567,7 +590,7 @@ static double predict_walls(const odhs_stepper *st, const double *G, const doubl
                     t = fmin(t, C / (-B + sqrt(disc)));
                 }
             }
-            if (t < best) {
+            if (t < best && !corner_duplicate(st, i, w, x, u, t)) {
                 best = t;
                 *pi = i;
                 *pj = st->n + w;
@@ -901,7 +924,15 @@ static int correct(odhs_stepper *st, int *added)
         if (isostatic) return ODHS_OK; /* N singular: the rewiring handles it (f0) */
         prev = gmax;
         memset(st->cx, 0, nc * sizeof *st->cx);
-        if ((s = solve(st, net->gap, st->cx))) return s;
+        if ((s = solve(st, net->gap, st->cx))) {
+            /* a (nearly) redundant contact makes N singular for this
+             * right-hand side: the correction waits for the next interval */
+            if (s == ODHS_E_SINGULAR || s == ODHS_E_NOCONV) {
+                odhs__solver_invalidate(st->sol); /* its failed setup is not reusable */
+                return ODHS_OK;
+            }
+            return s;
+        }
         odhs__net_ST(net, st->cx, st->tmp);
         for (size_t k = 0; k < st->nd; ++k) st->tmp[k] = -st->tmp[k];
         size_t pi, pj;
@@ -1036,6 +1067,21 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         odhs__net_geometry(net, sys);
         memcpy(st->G, G0, sizeof G0);
         st->kappa = k0;
+        if (s == ODHS_E_SINGULAR || s == ODHS_E_NOCONV) {
+            /* the predictor's configuration is only a probe (no collision
+             * checks): its network may be degenerate there. Shorter probes,
+             * and in the end the Euler chord of the start velocities. */
+            memcpy(st->U, st->U0, nd * sizeof *st->U);
+            st->nrejected++;
+            if (attempt < 20) {
+                st->h *= 0.25;
+                continue;
+            }
+            memcpy(st->Ua, st->U0, nd * sizeof *st->Ua);
+            memcpy(Ga, G0, sizeof G0);
+            *tau_out = tau;
+            return ODHS_OK;
+        }
         if (s) {
             memcpy(st->U, st->U0, nd * sizeof *st->U);
             return s;
@@ -1207,6 +1253,8 @@ again:;
                 limit = fmax(tstar * (1.0 + 1e-9), 1e-6 * t);
                 goto again;
             }
+        } else if (s == ODHS_E_SINGULAR || s == ODHS_E_NOCONV) {
+            s = ODHS_OK; /* locating the opening is a probe: the rewiring below decides */
         } else if (s) {
             goto fail;
         }
@@ -1572,7 +1620,7 @@ int odhs_stepper_errors(const odhs_stepper *st, double *contact_gap, double *ove
         for (size_t w = 0; w < net->nwalls; ++w)
             for (size_t i = 0; i < s->n; ++i) {
                 double nrm[3];
-                double g = odhs__wall_geom(&net->walls[w], s->dim, s->x + i * s->dim, nrm) - s->r[i];
+                double g = odhs__wall_geom(&net->walls[w], s->dim, s->L, s->gamma, s->x + i * s->dim, nrm, NULL) - s->r[i];
                 c.worst = fmax(c.worst, -g / s->r[i]);
             }
         *overlap = c.worst > 0.0 ? c.worst : 0.0;

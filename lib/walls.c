@@ -31,7 +31,7 @@ static int add_wall(odhs_stepper *st, odhs_wall *w, size_t *id)
     size_t wi = SIZE_MAX;
     for (size_t i = 0; i < st->n; ++i) {
         double nrm[3];
-        double g = odhs__wall_geom(w, dim, sys->x + i * dim, nrm) - sys->r[i];
+        double g = odhs__wall_geom(w, dim, sys->L, sys->gamma, sys->x + i * dim, nrm, NULL) - sys->r[i];
         if (g < -1e-9 * sys->r[i] && -g > worst) {
             worst = -g;
             wi = i;

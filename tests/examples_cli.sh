@@ -76,5 +76,12 @@ expect_in cp.csv "^strain,shear_stress,pressure,z,events,bond_error" "composite 
 head -c 4 "$tmp/cp.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: composite svg"; fail=$((fail + 1)); }
 # rigid bodies: the bond error column stays at round-off
 awk -F, 'NR > 1 && $6 > 1e-12 { bad = 1 } END { exit bad }' "$tmp/cp.csv" && pass=$((pass + 1)) || { echo "FAIL: composite bond error"; fail=$((fail + 1)); }
+expect 0 "hopper help" -- "$bin/hopper" --help
+expect_in out "usage: hopper" "hopper --help prints usage"
+expect 2 "hopper bad outlet" -- "$bin/hopper" --outlet 0.5
+expect 0 "hopper short run" -- "$bin/hopper" --n 40 --time 6 --every 2 --series "$tmp/h.csv" --svg "$tmp/h.svg"
+expect_in h.csv "^time,discharged,mean_speed,z,events" "hopper writes its series header"
+expect_in out "^clogged: " "hopper reports whether the outlet clogged"
+head -c 4 "$tmp/h.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: hopper svg"; fail=$((fail + 1)); }
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -641,7 +641,7 @@ static int pcg_rowadd(pcg_state *s, const odhs_network *net, size_t c, size_t t)
     double dd = 0.0;
     for (int k = 0; k < d; ++k) dd += nc_[k] * nc_[k];
     Ri[nz] = s->pinv[t];
-    Rx[nz++] = 2.0 * dd;
+    Rx[nz++] = (net->cj[c] < net->n ? 2.0 : 1.0) * dd; /* a wall contact has one block */
     size_t ends[2] = {net->ci[c], net->cj[c]};
     for (int e = 0; e < 2; ++e) {
         size_t p = ends[e];
