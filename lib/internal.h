@@ -120,20 +120,23 @@ typedef struct {
 
 /* Distance from a particle centre x to the wall surface (positive on the
  * allowed side) and the unit contact normal nrm from the particle towards
- * the wall. Walls are not periodic: the particle is taken at its periodic
- * image nearest to the wall's reference point (a point of a plane, a
- * sphere's centre, a segment's middle), written to ximg when not NULL, so a
- * particle touching a wall may cross the box boundary. */
+ * the wall. Walls are not periodic: for a sphere or a segment the particle
+ * is taken at its periodic image nearest to the centre or the middle, so a
+ * particle touching it may cross the box boundary; a plane sees the position
+ * in the primary cell. The position used goes to ximg when not NULL. */
 static inline double odhs__wall_geom(const odhs_wall *w, int dim, const double *L, double gamma, const double *x0,
                                      double *nrm, double *ximg)
 {
     double ref[3] = {0, 0, 0}, x[3] = {0, 0, 0};
-    for (int k = 0; k < dim; ++k)
-        ref[k] = w->type == ODHS_WALL_PLANE ? w->h * w->n[k]
-                 : w->type == ODHS_WALL_SPHERE ? w->c[k] : 0.5 * (w->c[k] + w->b[k]);
-    for (int k = 0; k < dim; ++k) x[k] = x0[k] - ref[k];
-    odhs__min_image(dim, L, gamma, x, NULL);
-    for (int k = 0; k < dim; ++k) x[k] += ref[k];
+    for (int k = 0; k < dim; ++k) x[k] = x0[k];
+    if (w->type != ODHS_WALL_PLANE) { /* a plane is unbounded: the primary cell's position */
+        for (int k = 0; k < dim; ++k) {
+            ref[k] = w->type == ODHS_WALL_SPHERE ? w->c[k] : 0.5 * (w->c[k] + w->b[k]);
+            x[k] = x0[k] - ref[k];
+        }
+        odhs__min_image(dim, L, gamma, x, NULL);
+        for (int k = 0; k < dim; ++k) x[k] += ref[k];
+    }
     if (ximg)
         for (int k = 0; k < dim; ++k) ximg[k] = x[k];
     if (w->type == ODHS_WALL_PLANE) {
