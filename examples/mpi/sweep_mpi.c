@@ -780,7 +780,8 @@ static double nice_step(double range, int target)
 /* A line plot with error bars: one series per group (points with the same
  * group id, already sorted by x). logy: logarithmic y axis. */
 static int write_plot(const char *path, const char *title, const char *xlabel, const char *ylabel, int logy,
-                      const plot_pt *pt, const int *group, int npt, char labels[][64], int ngroups)
+                      const plot_pt *pt, const int *group, int npt, char labels[][64], int ngroups, double refy,
+                      const char *reflabel)
 {
     static const char *colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf"};
     const double W = 560, H = 400, ml = 78, mr = 20, mt = 36, mb = 56;
@@ -792,6 +793,7 @@ static int write_plot(const char *path, const char *title, const char *xlabel, c
         ymin = fmin(ymin, lo), ymax = fmax(ymax, hi);
     }
     if (npt == 0 || (logy && ymin <= 0)) return -1;
+    if (!isnan(refy)) ymin = fmin(ymin, refy), ymax = fmax(ymax, refy);
     if (xmax - xmin < 1e-9) xmin -= 0.01, xmax += 0.01;
     double xpad = 0.05 * (xmax - xmin);
     xmin -= xpad, xmax += xpad;
@@ -848,6 +850,12 @@ static int write_plot(const char *path, const char *title, const char *xlabel, c
     sb_printf(&b, "<rect x=\"%g\" y=\"%g\" width=\"%g\" height=\"%g\" fill=\"none\" stroke=\"black\"/>\n", ml, mt, pw, ph);
     sb_printf(&b, "<text x=\"%g\" y=\"%g\" text-anchor=\"middle\">%s</text>\n", ml + pw / 2, H - 14, xlabel);
     sb_printf(&b, "<text transform=\"translate(20,%g) rotate(-90)\" text-anchor=\"middle\">%s</text>\n", mt + ph / 2, ylabel);
+    if (!isnan(refy)) {
+        sb_printf(&b, "<line x1=\"%g\" y1=\"%.1f\" x2=\"%g\" y2=\"%.1f\" stroke=\"#555\" stroke-dasharray=\"6,4\"/>\n", ml,
+                  YP(refy), ml + pw, YP(refy));
+        sb_printf(&b, "<text x=\"%g\" y=\"%.1f\" text-anchor=\"end\" fill=\"#555\">%s</text>\n", ml + pw - 6, YP(refy) + 16,
+                  reflabel);
+    }
     /* series */
     for (int g = 0; g < ngroups; ++g) {
         const char *c = colors[g % 6];
@@ -868,8 +876,10 @@ static int write_plot(const char *path, const char *title, const char *xlabel, c
             }
             sb_printf(&b, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3.5\" fill=\"%s\"/>\n", X, Y, c);
         }
-        sb_printf(&b, "<circle cx=\"%g\" cy=\"%g\" r=\"3.5\" fill=\"%s\"/>\n", ml + 14, mt + 16 + 18 * g, c);
-        sb_printf(&b, "<text x=\"%g\" y=\"%g\">%s</text>\n", ml + 24, mt + 20 + 18 * g, labels[g]);
+        /* legend at the bottom right (the curves rise with phi) */
+        double ly = mt + ph - 14 - 18 * (ngroups - 1 - g);
+        sb_printf(&b, "<circle cx=\"%g\" cy=\"%g\" r=\"3.5\" fill=\"%s\"/>\n", ml + pw - 14, ly - 4, c);
+        sb_printf(&b, "<text x=\"%g\" y=\"%g\" text-anchor=\"end\">%s</text>\n", ml + pw - 24, ly, labels[g]);
     }
     sb_printf(&b, "</svg>\n");
 #undef XP
@@ -1003,12 +1013,15 @@ static int write_summary(const settings *S)
     }
     if (npt > 0) {
         snprintf(path, sizeof path, "%s/eta_phi.svg", S->out);
-        if (write_plot(path, "Shear viscosity at fixed volume (mean and s.e. over seeds)", "packing fraction phi",
-                       "eta = sigma_xy / gammadot  [1/xi0]", 1, pe, grp, npt, labels, ngr))
+        if (write_plot(path, "Shear viscosity at fixed volume (mean \u00b1 s.e. over seeds)", "packing fraction \u03c6",
+                       "\u03b7 = \u03c3<tspan baseline-shift=\"sub\" font-size=\"10\">xy</tspan> / \u03b3\u0307   [1/\u03be<tspan baseline-shift=\"sub\" font-size=\"10\">0</tspan>]", 1, pe, grp, npt, labels, ngr, NAN, ""))
             LOG("no eta(phi) plot (non-positive viscosities)");
         snprintf(path, sizeof path, "%s/z_phi.svg", S->out);
-        bad |= write_plot(path, "Mean coordination at fixed volume (mean and s.e. over seeds)", "packing fraction phi",
-                          "z = 2 Nc / N", 0, pz, grp, npt, labels, ngr);
+        int dim0 = (int)gkey[0][0], same = 1;
+        for (int h = 1; h < ngr; ++h) same &= (int)gkey[h][0] == dim0;
+        bad |= write_plot(path, "Mean coordination at fixed volume (mean \u00b1 s.e. over seeds)", "packing fraction \u03c6",
+                          "z = 2 N<tspan baseline-shift=\"sub\" font-size=\"10\">c</tspan> / N", 0, pz, grp, npt, labels, ngr, same ? 2.0 * dim0 : NAN,
+                          "isostatic z = 2d (jamming)");
     }
     free(pe), free(pz), free(grp), free(labels);
     free(runs.s), free(sum.s), free(R), free(sp_of), free(sp);
