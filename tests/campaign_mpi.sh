@@ -31,14 +31,23 @@ rc=$?
 echo "== MPI run on 2 ranks, killed mid-way"
 "${mpirun[@]}" -np 2 "$bin/sweep_mpi" --campaign "$campaign" --out "$work/mpi" > "$work/mpi1.out" 2> "$work/mpi1.err" &
 mpirun_pid=$!
-killed=0
+# Kill point: at least 2 runs finished and a checkpoint of a run that is far
+# from its end (under 60 of its 101 series rows written), so that the run is
+# certainly unfinished when the kill lands.
+killed=0 ranks=
 for _ in $(seq 1 1200); do
     sleep 0.05
     kill -0 $mpirun_pid 2>/dev/null || break
+    [ -n "$ranks" ] || ranks=$(children $mpirun_pid)
     nres=$(ls "$work"/mpi/runs/*/result.csv 2>/dev/null | wc -l)
-    nck=$(ls "$work"/mpi/runs/*/checkpoint.odhs 2>/dev/null | wc -l)
-    if [ "$nres" -ge 2 ] && [ "$nck" -ge 1 ]; then
-        ranks=$(children $mpirun_pid)
+    early=0
+    for ck in "$work"/mpi/runs/*/checkpoint.odhs; do
+        [ -e "$ck" ] || continue
+        rows=$(wc -l < "${ck%checkpoint.odhs}series.csv" 2>/dev/null || echo 999)
+        [ "$rows" -lt 60 ] && early=1
+    done
+    if [ "$nres" -ge 2 ] && [ $early -eq 1 ] && [ "$(echo $ranks | wc -w)" -eq 2 ]; then
+        nck=$(ls "$work"/mpi/runs/*/checkpoint.odhs 2>/dev/null | wc -l)
         echo "  killing ranks (pids $(echo $ranks)) with SIGKILL: $nres results, $nck checkpoints on disk"
         for p in $ranks; do kill -KILL "$p" 2>/dev/null; done
         killed=1
@@ -53,6 +62,16 @@ nruns=$(grep -c '^[0-9]' "$campaign")
 [ "$nres" -lt "$nruns" ] && [ "$nck" -ge 1 ] && ok "after the kill: $nres of $nruns results, $nck checkpoint(s)" \
     || bad "after the kill: $nres of $nruns results, $nck checkpoints"
 
+# A kill can also land in the middle of a series row: append a torn row to
+# every unfinished series, which the resume must cut away with the rows
+# written after the checkpoint.
+for ck in "$work"/mpi/runs/*/checkpoint.odhs; do
+    [ -e "$ck" ] || continue
+    f="${ck%checkpoint.odhs}series.csv"
+    echo "  $(basename "$(dirname "$f")"): $(($(wc -l < "$f") - 1)) series rows at the kill, plus a torn row appended"
+    printf '0.123456,9.87' >> "$f"
+done
+
 echo "== MPI run on 2 ranks, re-launched"
 "${mpirun[@]}" -np 2 "$bin/sweep_mpi" --campaign "$campaign" --out "$work/mpi" > "$work/mpi2.out" 2> "$work/mpi2.err"
 rc=$?
@@ -60,6 +79,7 @@ rc=$?
 grep -q "already done" "$work/mpi2.err" && ok "$(grep -o '[0-9]* runs, [0-9]* already done, [0-9]* to do' "$work/mpi2.err")"
 nresumed=$(grep -c "resuming from its checkpoint" "$work/mpi2.err")
 [ "$nresumed" -ge 1 ] && ok "$nresumed run(s) resumed from a checkpoint" || bad "no run resumed from a checkpoint"
+grep "resuming from its checkpoint" "$work/mpi2.err" | sed 's/^/    /'
 grep -q "rank 1" "$work"/mpi/runs/*/timing.txt && grep -q "rank 0" "$work"/mpi/runs/*/timing.txt \
     && ok "both ranks ran runs" || bad "runs were not spread over both ranks"
 ls "$work"/mpi/runs/*/checkpoint.odhs >/dev/null 2>&1 && bad "checkpoints left after completion" || ok "no checkpoint left"

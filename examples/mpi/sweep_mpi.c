@@ -615,7 +615,7 @@ static int run_one(const settings *S, int idx)
             truncate_series(P.series, k + 1) == 0 && (series = fopen(P.series, "a"))) {
             resumed = 1;
             g_start = g;
-            if (!S->quiet) LOG("run %d: resuming from its checkpoint at strain %.4g", idx, g);
+            if (!S->quiet) LOG("run %d: resuming from its checkpoint at strain %.4g (series cut back to %ld rows)", idx, g, k + 1);
         } else {
             LOG("run %d: unusable checkpoint (%s), starting over", idx, rc ? cerr : "does not match the series");
             odhs_stepper_destroy(st);
