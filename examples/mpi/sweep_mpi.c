@@ -626,8 +626,7 @@ static int run_one(const settings *S, int idx)
         }
     }
     if (!resumed) {
-        if (!S->quiet)
-        {
+        if (!S->quiet) {
             char pstr[64] = "";
             if (r->driver == DRIVER_PRESSURE) snprintf(pstr, sizeof pstr, ", p = %g", r->pressure);
             LOG("run %d: %s, d = %lu, N = %lu, phi = %g%s, seed %lu, strain %g", idx, driver_name[r->driver], r->dim,
