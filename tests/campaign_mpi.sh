@@ -32,7 +32,7 @@ echo "== MPI run on 2 ranks, killed mid-way"
 "${mpirun[@]}" -np 2 "$bin/sweep_mpi" --campaign "$campaign" --out "$work/mpi" > "$work/mpi1.out" 2> "$work/mpi1.err" &
 mpirun_pid=$!
 # Kill point: at least 2 runs finished and a checkpoint of a run that is far
-# from its end (under 60 of its 101 series rows written), so that the run is
+# from its end (under 40 of its 61 series rows written), so that the run is
 # certainly unfinished when the kill lands.
 killed=0 ranks=
 for _ in $(seq 1 1200); do
@@ -44,7 +44,7 @@ for _ in $(seq 1 1200); do
     for ck in "$work"/mpi/runs/*/checkpoint.odhs; do
         [ -e "$ck" ] || continue
         rows=$(wc -l < "${ck%checkpoint.odhs}series.csv" 2>/dev/null || echo 999)
-        [ "$rows" -lt 60 ] && early=1
+        [ "$rows" -lt 40 ] && early=1
     done
     if [ "$nres" -ge 2 ] && [ $early -eq 1 ] && [ "$(echo $ranks | wc -w)" -eq 2 ]; then
         nck=$(ls "$work"/mpi/runs/*/checkpoint.odhs 2>/dev/null | wc -l)
