@@ -16,9 +16,14 @@
 #   check-symbols   fail if lib/libodhs.so exports anything not named odhs_*
 #   check-run       run the tests without deps-if-missing/check-symbols
 #   tests           only build the runner build/tests/run_tests
-#   examples        stage-install into build/stage, build examples/*.c against
-#                   it with pkg-config only, run pkgconfig-test
+#   examples        stage-install into build/stage, build examples/*.c (and
+#                   examples/mpi/sweep_mpi.c: sweep_serial, and sweep_mpi
+#                   when mpicc exists) against it with pkg-config only, run
+#                   pkgconfig-test
 #   pkgconfig-test  compile + run tests/pkgconfig_consumer.c, shared and static
+#   check-mpi       build examples/mpi/sweep_mpi.c with mpicc and run a tiny
+#                   campaign on 2 ranks, killed and resumed, against a serial
+#                   run (skipped when MPI is absent)
 #   stage           `make install` into build/stage (used by examples)
 #   demo            deps-if-missing, all, examples, run build/examples/shear_flow
 #   bench           build bench/*.c against lib/libodhs.a into build/bench/
@@ -33,6 +38,7 @@
 #   WARNFLAGS=...          warnings (default includes -Werror)
 #   CC, CFLAGS, CPPFLAGS, LDFLAGS, LDLIBS   appended as usual
 #   PREFIX, LIBDIR, INCLUDEDIR, DESTDIR     install locations
+#   MPICC=mpicc, MPIRUN=mpirun             MPI compiler wrapper and launcher
 
 # Disable the built-in implicit rules and variables: every rule is below.
 MAKEFLAGS += --no-builtin-rules
@@ -208,6 +214,18 @@ CONSUMER_CFLAGS ?= -std=c11 -O2 -g -Wall -Wextra -Wpedantic -Werror
 
 EXAMPLE_SRCS := $(sort $(wildcard examples/*.c))
 EXAMPLE_BINS := $(EXAMPLE_SRCS:examples/%.c=build/examples/%)
+
+# Ensemble campaigns (examples/mpi/sweep_mpi.c): sweep_mpi is built with the
+# MPI compiler wrapper when there is one; sweep_serial (the same source with
+# -DSWEEP_NO_MPI, the serial fallback) is always built.
+MPICC   ?= mpicc
+MPIRUN  ?= mpirun
+HAVE_MPI := $(if $(and $(shell command -v $(MPICC) 2>/dev/null),$(shell command -v $(MPIRUN) 2>/dev/null)),1,0)
+SWEEP_SRC := examples/mpi/sweep_mpi.c
+EXAMPLE_BINS += build/examples/sweep_serial
+ifeq ($(HAVE_MPI),1)
+EXAMPLE_BINS += build/examples/sweep_mpi
+endif
 
 PCTEST_DIR    := build/pkgconfig-test
 PCTEST_SHARED := $(PCTEST_DIR)/consumer-shared
@@ -419,6 +437,28 @@ build/examples/%: examples/%.c $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_
 	$(CC) $(CONSUMER_CFLAGS) -o $@ $< \
 	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) -lm $(STAGE_RPATH)
 
+build/examples/sweep_serial: $(SWEEP_SRC) examples/cli.h $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
+	@mkdir -p $(@D)
+	$(CC) $(CONSUMER_CFLAGS) -DSWEEP_NO_MPI -o $@ $< \
+	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) -lm $(STAGE_RPATH)
+
+build/examples/sweep_mpi: $(SWEEP_SRC) examples/cli.h $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
+	@mkdir -p $(@D)
+	$(MPICC) $(CONSUMER_CFLAGS) -o $@ $< \
+	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) -lm $(STAGE_RPATH)
+
+# The tiny campaign on 2 MPI ranks, killed and resumed, against a serial run
+# (tests/campaign_mpi.sh). Skipped, with a message, without mpicc/mpirun.
+.PHONY: check-mpi
+check-mpi:
+ifeq ($(HAVE_MPI),1)
+	@$(MAKE) --no-print-directory stage
+	@$(MAKE) --no-print-directory build/examples/sweep_mpi build/examples/sweep_serial
+	bash tests/campaign_mpi.sh build/examples
+else
+	@echo "check-mpi: SKIPPED: no MPI ($(MPICC) and $(MPIRUN) not both found; Debian: apt-get install openmpi-bin libopenmpi-dev, or make deps)"
+endif
+
 pkgconfig-test: stage
 	@$(MAKE) --no-print-directory pkgconfig-test-run
 
@@ -552,9 +592,11 @@ fuzz-ci: fuzz
 # ===========================================================================
 .PHONY: deps deps-if-missing
 # clang and libclang-rt-14-dev (libFuzzer, sanitizer runtimes): make fuzz.
+# openmpi-bin and libopenmpi-dev (mpicc, mpirun): sweep_mpi and make check-mpi.
 DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
                  check pkg-config gcc make \
-                 clang libclang-rt-14-dev
+                 clang libclang-rt-14-dev \
+                 openmpi-bin libopenmpi-dev
 
 deps:
 	@if [ "$$(id -u)" -eq 0 ]; then SUDO=; else SUDO=sudo; fi; \

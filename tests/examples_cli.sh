@@ -83,5 +83,25 @@ expect 0 "hopper short run" -- "$bin/hopper" --n 40 --time 6 --every 2 --series 
 expect_in h.csv "^time,discharged,mean_speed,z,events" "hopper writes its series header"
 expect_in out "^clogged: " "hopper reports whether the outlet clogged"
 head -c 4 "$tmp/h.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: hopper svg"; fail=$((fail + 1)); }
+# sweep_serial: examples/mpi/sweep_mpi.c built without MPI (its MPI twin is
+# exercised by make check-mpi)
+expect 0 "sweep_serial help" -- "$bin/sweep_serial" --help
+expect_in out "usage: sweep_mpi" "sweep_serial --help prints usage"
+expect 2 "sweep_serial unknown option" -- "$bin/sweep_serial" --no-such-option
+expect 2 "sweep_serial missing value" -- "$bin/sweep_serial" --out
+expect 2 "sweep_serial bad every" -- "$bin/sweep_serial" --every -1
+expect 2 "sweep_serial unknown solver" -- "$bin/sweep_serial" --solver nonsense
+expect 1 "sweep_serial unreadable campaign" -- "$bin/sweep_serial" --campaign "$tmp/does-not-exist.csv" --out "$tmp/sw"
+expect_in err "does-not-exist.csv" "sweep_serial names the unreadable campaign"
+printf 'n,phi,seed,strain\n64,1.5,1,0.3\n' > "$tmp/badphi.csv"
+expect 2 "sweep_serial phi out of range" -- "$bin/sweep_serial" --campaign "$tmp/badphi.csv" --out "$tmp/sw"
+expect_in err "line 2: bad value '1.5' for phi" "sweep_serial names the bad line and field"
+printf 'n,phi,colour\n' > "$tmp/badcol.csv"
+expect 2 "sweep_serial unknown column" -- "$bin/sweep_serial" --campaign "$tmp/badcol.csv" --out "$tmp/sw"
+printf 'n,phi,seed,strain\n64,0.7,1,0.1\n' > "$tmp/short.csv"
+expect 2 "sweep_serial strain within the transient" -- "$bin/sweep_serial" --campaign "$tmp/short.csv" --out "$tmp/sw"
+expect 0 "sweep_serial built-in campaign" -- "$bin/sweep_serial" --out "$tmp/sw" --quiet
+[ "$(grep -c ',ok,' "$tmp/sw/runs.csv")" -eq 4 ] && [ -s "$tmp/sw/eta_phi.svg" ] && pass=$((pass + 1)) \
+    || { echo "FAIL: sweep_serial built-in campaign results"; fail=$((fail + 1)); }
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
