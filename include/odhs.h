@@ -14,5 +14,6 @@
 #include "odhs/stepper.h"
 #include "odhs/jamming.h"
 #include "odhs/checkpoint.h"
+#include "odhs/softcore.h"
 
 #endif /* ODHS_H */
