@@ -127,6 +127,27 @@ static int nb_check(odhs_softcore *sc, const double *x)
 }
 
 /* ---- elastic forces ------------------------------------------------------------ */
+/* Minimum image for separations of particles that are at most a few box
+ * lengths out of the primary cell (positions are wrapped every few
+ * iterations): a branch per axis instead of a libm rounding call. */
+static inline void min_image_fast(int d, const double *L, double gL, double *v)
+{
+    while (v[1] > 0.5 * L[1]) {
+        v[1] -= L[1];
+        v[0] -= gL;
+    }
+    while (v[1] < -0.5 * L[1]) {
+        v[1] += L[1];
+        v[0] += gL;
+    }
+    if (d == 3) {
+        while (v[2] > 0.5 * L[2]) v[2] -= L[2];
+        while (v[2] < -0.5 * L[2]) v[2] += L[2];
+    }
+    while (v[0] > 0.5 * L[0]) v[0] -= L[0];
+    while (v[0] < -0.5 * L[0]) v[0] += L[0];
+}
+
 static inline double powm1(double delta, double alpha)
 {
     if (alpha == 2.0) return delta;
@@ -163,7 +184,7 @@ static int elastic(odhs_softcore *sc, const double *x, double *F, double *U, dou
     int d = sc->dim;
     if (F) memset(F, 0, sc->nd * sizeof *F);
     if (sig) memset(sig, 0, 9 * sizeof *sig);
-    double Usum = 0.0, mo = 0.0;
+    double Usum = 0.0, mo = 0.0, gL = sys->gamma * sys->L[1];
     sc->nc = 0;
     sc->fc_ok = 0;
     sc->nforce++;
@@ -171,7 +192,7 @@ static int elastic(odhs_softcore *sc, const double *x, double *F, double *U, dou
         size_t i = sc->pi[p], j = sc->pj[p];
         double v[3] = {0, 0, 0};
         for (int k = 0; k < d; ++k) v[k] = x[j * d + k] - x[i * d + k];
-        odhs__min_image(d, sys->L, sys->gamma, v, NULL);
+        min_image_fast(d, sys->L, gL, v);
         double r2 = 0.0;
         for (int k = 0; k < d; ++k) r2 += v[k] * v[k];
         double dij = sys->r[i] + sys->r[j];
@@ -289,6 +310,7 @@ static int od_velocity(odhs_softcore *sc, const double *x, double *F, double *u)
     int s = elastic(sc, x, F, NULL, NULL, NULL);
     if (s) return s;
     if (sc->model == ODHS_SOFTCORE_CD0) return cd0_solve(sc, F, u);
+    if (!(sc->kd > 0.0)) return scerr(sc, ODHS_E_UNSUPPORTED, "RD0 needs a drag coefficient k_d > 0");
     double m = 1.0 / sc->kd;
     for (size_t k = 0; k < sc->nd; ++k) u[k] = m * F[k];
     return ODHS_OK;
@@ -468,7 +490,16 @@ int odhs_softcore_set_potential(odhs_softcore *sc, double alpha, double k_e)
         return ODHS_OK;                                                                       \
     }
 
-POSITIVE_SETTER(odhs_softcore_set_drag, kd, "drag coefficient k_d")
+int odhs_softcore_set_drag(odhs_softcore *sc, double kd)
+{
+    SCNULL(sc);
+    if (!isfinite(kd)) return scerr(sc, ODHS_E_NONFINITE, "drag coefficient k_d is not finite");
+    if (!(kd >= 0.0)) return scerr(sc, ODHS_E_INVALID, "drag coefficient k_d must be >= 0, got %g", kd);
+    sc->kd = kd;
+    sc->h_ad = 0.0;
+    return ODHS_OK;
+}
+
 POSITIVE_SETTER(odhs_softcore_set_mass, mass, "mass")
 
 int odhs_softcore_set_substrate(odhs_softcore *sc, double k0)
@@ -602,7 +633,7 @@ static double base_step(const odhs_softcore *sc)
 {
     double h;
     if (is_massive(sc->model)) {
-        double tm = sqrt(sc->mass * sc->dmin * sc->dmin / sc->ke), td = sc->mass / sc->kd;
+        double tm = sqrt(sc->mass * sc->dmin * sc->dmin / sc->ke), td = sc->kd > 0.0 ? sc->mass / sc->kd : INFINITY;
         h = sc->cdt * (tm < td ? tm : td);
     } else {
         h = sc->cdt * tau_e(sc);
@@ -756,6 +787,10 @@ static int step_sllod(odhs_softcore *sc, double h)
 /* one step of at most hmax; *taken receives its length */
 static int step_once(odhs_softcore *sc, double hmax, double *taken)
 {
+    if (sc->model == ODHS_SOFTCORE_RD0 && !(sc->kd > 0.0))
+        return scerr(sc, ODHS_E_UNSUPPORTED, "RD0 needs a drag coefficient k_d > 0");
+    if (sc->model == ODHS_SOFTCORE_CD0 && !(sc->k0 > 0.0))
+        return scerr(sc, ODHS_E_UNSUPPORTED, "CD0 needs a substrate drag k_0 > 0");
     double gam, str, tim;
     snapshot(sc, &gam, &str, &tim);
     double h = base_step(sc);
@@ -999,6 +1034,8 @@ static int minimise_inner(odhs_softcore *sc, uint64_t *iters)
 {
     int s;
     *iters = 0;
+    if (sc->minimiser == ODHS_SOFTCORE_SD && !(sc->kd > 0.0))
+        return scerr(sc, ODHS_E_UNSUPPORTED, "steepest descent needs a drag coefficient k_d > 0 (its mobility)");
     switch (sc->minimiser) {
     case ODHS_SOFTCORE_FIRE: s = min_fire(sc, iters); break;
     case ODHS_SOFTCORE_CG: s = min_cg(sc, iters); break;

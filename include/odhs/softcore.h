@@ -136,7 +136,10 @@ ODHS_API const char *odhs_softcore_errmsg(const odhs_softcore *sc);
 ODHS_API int odhs_softcore_set_model(odhs_softcore *sc, int model);
 /** Potential exponent alpha (> 1, at most 10) and stiffness k_e (> 0). */
 ODHS_API int odhs_softcore_set_potential(odhs_softcore *sc, double alpha, double k_e);
-/** Drag coefficient k_d (> 0): reservoir drag (RD0, RD) or pair drag (CD*). */
+/** Drag coefficient k_d (>= 0): reservoir drag (RD0, RD) or pair drag
+ *  (CD*). 0 is allowed (e.g. dissipation-free SLLOD, or CD0 with only the
+ *  substrate drag); RD0 steps and steepest descent then fail with
+ *  ODHS_E_UNSUPPORTED. */
 ODHS_API int odhs_softcore_set_drag(odhs_softcore *sc, double k_d);
 /** Substrate drag k_0 (>= 0) of CD0 (must be > 0 when CD0 steps). */
 ODHS_API int odhs_softcore_set_substrate(odhs_softcore *sc, double k_0);
@@ -183,7 +186,7 @@ ODHS_API int odhs_softcore_reset(odhs_softcore *sc);
  * Take one time step of the current model at the current shear rate.
  * Errors (the step is rolled back): ODHS_E_NONFINITE (the integration blew up:
  * reduce the step), ODHS_E_NOCONV (CD0 solve), ODHS_E_UNSUPPORTED (CD0 with
- * k_0 = 0), ODHS_E_NOMEM.
+ * k_0 = 0, RD0 with k_d = 0), ODHS_E_NOMEM.
  */
 ODHS_API int odhs_softcore_step(odhs_softcore *sc);
 /** Step until the accumulated strain reaches gamma (the last step is
