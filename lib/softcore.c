@@ -1250,7 +1250,7 @@ int odhs_softcore_pressure(odhs_softcore *sc, double *p)
     if (s) return s;
     double tr = 0.0;
     for (int a = 0; a < sc->dim; ++a) tr += sig[a * sc->dim + a];
-    *p = -tr / sc->dim;
+    *p = -tr / sc->dim + 0.0; /* no -0 */
     return ODHS_OK;
 }
 
