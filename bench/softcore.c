@@ -24,9 +24,14 @@
  *     (m = 1): Newtonian (sigma ~ gammadot) against Bagnold (sigma ~
  *     gammadot^2).
  *
+ *  A2 ("softcore inertial" runs only this): one affine strain step, then
+ *     SD, FIRE and CG from the same overlapped state; distance between the
+ *     minima relative to the SD relaxation displacement.
+ *
  * Writes SVG plots into OUTDIR (default docs/results).
  *
  * usage: softcore [GA] [GB] [OUTDIR]   (defaults 0.002, 0.005, docs/results)
+ *        softcore inertial
  */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -342,8 +347,57 @@ static double viscosity(const odhs_system *start, int model, double rate, double
     return sum / cnt / rate;
 }
 
+/* A2: one affine step dg from the start, then SD, FIRE and CG from the same
+ * overlapped state: how far apart do the minima lie, relative to the
+ * steepest-descent (overdamped) relaxation displacement? */
+static void inertial_paths(const odhs_system *start)
+{
+    printf("\n## A2. one strain step dgamma, then minimisation to max|grad U| < 1e-9 from the same state\n");
+    printf("%-10s %12s %12s %14s %14s %10s %10s %10s\n", "dgamma", "rms_relax_SD", "rms_FIRE-SD", "FIRE-SD/relax",
+           "CG-SD/relax", "t_SD_s", "t_FIRE_s", "t_CG_s");
+    double dgs[3] = {1e-5, 1e-4, 1e-3};
+    int mins[3] = {ODHS_SOFTCORE_SD, ODHS_SOFTCORE_FIRE, ODHS_SOFTCORE_CG};
+    for (int q = 0; q < 3; ++q) {
+        double X[3][2 * N], Xa[2 * N], t[3];
+        for (int m = 0; m < 3; ++m) {
+            odhs_system *sys;
+            C(odhs_system_clone(start, &sys));
+            odhs_softcore *sc;
+            C(odhs_softcore_create(sys, &sc));
+            C(odhs_softcore_set_min_tolerance(sc, 1e300, 1)); /* affine only */
+            C(odhs_softcore_quasistatic_step(sc, dgs[q], NULL));
+            if (m == 0) C(odhs_system_get_positions(sys, Xa));
+            C(odhs_softcore_set_minimiser(sc, mins[m]));
+            C(odhs_softcore_set_min_tolerance(sc, 1e-9, 1000000000u));
+            double t0 = now();
+            C(odhs_softcore_minimise(sc, NULL));
+            t[m] = now() - t0;
+            C(odhs_system_get_positions(sys, X[m]));
+            odhs_softcore_destroy(sc);
+            odhs_system_destroy(sys);
+        }
+        odhs_system *bare;
+        double L[2];
+        C(odhs_system_get_box(start, L));
+        C(odhs_system_create(2, 1, &bare));
+        C(odhs_system_set_box(bare, L));
+        C(odhs_system_set_strain(bare, dgs[q]));
+        double relax = rms_diff(bare, Xa, X[0]), df = rms_diff(bare, X[0], X[1]), dc = rms_diff(bare, X[0], X[2]);
+        odhs_system_destroy(bare);
+        printf("%-10.0e %12.3e %12.3e %14.3e %14.3e %10.2f %10.2f %10.2f\n", dgs[q], relax, df, df / relax, dc / relax,
+               t[0], t[1], t[2]);
+    }
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "inertial")) {
+        setvbuf(stdout, NULL, _IONBF, 0);
+        odhs_system *s = start_state(0.82, 7);
+        inertial_paths(s);
+        odhs_system_destroy(s);
+        return 0;
+    }
     double GA = argc > 1 ? atof(argv[1]) : 0.002, GB = argc > 2 ? atof(argv[2]) : 0.005;
     const char *outdir = argc > 3 ? argv[3] : "docs/results";
     char cpu[256], path[512];

@@ -315,6 +315,65 @@ START_TEST(test_cd0)
 }
 END_TEST
 
+/* largest minimum-image distance between the positions of two systems */
+static double max_diff(const odhs_system *sa, const odhs_system *sb)
+{
+    size_t n = odhs_system_count(sa);
+    double *xa = malloc(2 * n * sizeof *xa), *xb = malloc(2 * n * sizeof *xb), L[2], g, err = 0.0;
+    CHECK_OK(odhs_system_get_positions(sa, xa));
+    CHECK_OK(odhs_system_get_positions(sb, xb));
+    CHECK_OK(odhs_system_get_box(sa, L));
+    CHECK_OK(odhs_system_get_strain(sa, &g));
+    for (size_t i = 0; i < n; ++i) {
+        double d[2] = {xb[2 * i] - xa[2 * i], xb[2 * i + 1] - xa[2 * i + 1]};
+        double ny = nearbyint(d[1] / L[1]);
+        d[1] -= ny * L[1];
+        d[0] -= ny * g * L[1];
+        d[0] -= nearbyint(d[0] / L[0]) * L[0];
+        err = fmax(err, hypot(d[0], d[1]));
+    }
+    free(xa);
+    free(xb);
+    return err;
+}
+
+/* the adaptive integrator against fixed Euler steps, RD0 and CD0: with the
+ * reference Euler c = 2e-4 (global error O(c)), Euler c = 2e-3 is about 10x
+ * further from it, adaptive Heun at tol 1e-8 much closer */
+START_TEST(test_adaptive)
+{
+    int models[2] = {ODHS_SOFTCORE_RD0, ODHS_SOFTCORE_CD0};
+    for (int m = 0; m < 2; ++m) {
+        odhs_softcore *h[3];
+        odhs_system *s[3];
+        s[0] = overlapped(2, 24, 0.55, 0.15, 17, &h[0]);
+        double x[48];
+        CHECK_OK(odhs_system_get_positions(s[0], x));
+        for (int k = 1; k < 3; ++k) {
+            CHECK_OK(odhs_system_clone(s[0], &s[k]));
+            CHECK_OK(odhs_softcore_create(s[k], &h[k]));
+        }
+        for (int k = 0; k < 3; ++k) {
+            CHECK_OK(odhs_softcore_set_model(h[k], models[m]));
+            CHECK_OK(odhs_softcore_set_substrate(h[k], 0.5));
+            CHECK_OK(odhs_softcore_set_shear_rate(h[k], 1e-2));
+        }
+        CHECK_OK(odhs_softcore_set_dt(h[0], 2e-4));
+        CHECK_OK(odhs_softcore_set_dt(h[1], 2e-3));
+        CHECK_OK(odhs_softcore_set_integrator(h[2], ODHS_SOFTCORE_ADAPTIVE));
+        CHECK_OK(odhs_softcore_set_tolerance(h[2], 1e-8));
+        for (int k = 0; k < 3; ++k) CHECK_OK(odhs_softcore_run_until_time(h[k], 2.0));
+        double e_coarse = max_diff(s[0], s[1]), e_adapt = max_diff(s[0], s[2]);
+        ck_assert_msg(e_coarse > 0.0 && e_adapt < 0.3 * e_coarse && e_adapt < 1e-3,
+                      "model %d: Euler c=2e-3 %.3g, adaptive %.3g from Euler c=2e-4", models[m], e_coarse, e_adapt);
+        for (int k = 0; k < 3; ++k) {
+            odhs_softcore_destroy(h[k]);
+            odhs_system_destroy(s[k]);
+        }
+    }
+}
+END_TEST
+
 /* minimum-image rms difference of two systems' positions, in units of len */
 static double rms_diff(const odhs_system *a, const odhs_system *b)
 {
@@ -413,6 +472,7 @@ Suite *make_softcore_suite(void)
     tcase_add_test(tc, test_minimisers);
     tcase_add_test(tc, test_sllod);
     tcase_add_test(tc, test_cd0);
+    tcase_add_test(tc, test_adaptive);
     tcase_add_test(tc, test_hs_limit);
     suite_add_tcase(s, tc);
     return s;
