@@ -6,6 +6,7 @@
  * Copyright (C) 2026 the libodhs authors. LGPL-2.1-or-later, see LICENSE.
  */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -36,7 +37,8 @@ struct odhs_softcore {
     double dmin, lambda; /* smallest and mean diameter */
     /* neighbour (Verlet) list */
     size_t *pi, *pj;
-    size_t np, pcap;
+    uint64_t *pk;        /* sort keys i*n + j (pkcap) */
+    size_t np, pcap, pkcap;
     double skin;
     double *xb;          /* positions at the last build */
     double strain_b;
@@ -50,6 +52,9 @@ struct odhs_softcore {
     double *relax;       /* dim*dim: integral of sigma dt over the last SD relaxation */
     double relax_acc[9];
     int has_relax;
+    uint64_t nforce_s;   /* snapshot of the counter (rollback) */
+    int fc_ok_s;
+    double h_ad_s;
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
@@ -87,6 +92,12 @@ static int nb_push(size_t i, size_t j, const double *rij, double gap, void *ctx)
     return 0;
 }
 
+static int key_cmp(const void *a, const void *b)
+{
+    uint64_t u = *(const uint64_t *)a, v = *(const uint64_t *)b;
+    return (u > v) - (u < v);
+}
+
 static int nb_build(odhs_softcore *sc, const double *x)
 {
     odhs_system *sys = sc->sys;
@@ -96,9 +107,25 @@ static int nb_build(odhs_softcore *sc, const double *x)
     sc->np = 0;
     int s = odhs__pairs(d, sc->n, sc->xw, sys->r, sys->rmax, sys->L, sys->gamma, sc->skin, nb_push, sc);
     if (s == ODHS_STOPPED) s = ODHS_E_NOMEM;
+    if (s == ODHS_OK && sc->np > sc->pkcap) {
+        uint64_t *k = odhs__realloc(sc->pk, sc->pcap * sizeof *k);
+        if (!k) s = ODHS_E_NOMEM;
+        else {
+            sc->pk = k;
+            sc->pkcap = sc->pcap;
+        }
+    }
     if (s != ODHS_OK) {
         sc->nb_ok = 0;
         return scerr(sc, s, "neighbour list: %s", odhs_strerror(s));
+    }
+    /* a fixed order (by pair) makes every sum independent of where and when
+     * the list was built: pairs that do not overlap contribute exact zeros */
+    for (size_t p = 0; p < sc->np; ++p) sc->pk[p] = (uint64_t)sc->pi[p] * sc->n + sc->pj[p];
+    qsort(sc->pk, sc->np, sizeof *sc->pk, key_cmp);
+    for (size_t p = 0; p < sc->np; ++p) {
+        sc->pi[p] = (size_t)(sc->pk[p] / sc->n);
+        sc->pj[p] = (size_t)(sc->pk[p] % sc->n);
     }
     memcpy(sc->xb, x, sc->nd * sizeof *x);
     sc->strain_b = sc->strain;
@@ -180,6 +207,9 @@ static int elastic(odhs_softcore *sc, const double *x, double *F, double *U, dou
 {
     int s = nb_check(sc, x);
     if (s) return s;
+    /* reserve first: a failure leaves the forces and the contact list of the
+     * last evaluation intact (the massive models' cache survives a rollback) */
+    if (ct_reserve(sc, sc->np > 0 ? sc->np : 1)) return scerr(sc, ODHS_E_NOMEM, "out of memory (contact list)");
     odhs_system *sys = sc->sys;
     int d = sc->dim;
     if (F) memset(F, 0, sc->nd * sizeof *F);
@@ -203,7 +233,6 @@ static int elastic(odhs_softcore *sc, const double *x, double *F, double *U, dou
         double pm = powm1(delta, sc->alpha);
         double f = sc->ke / dij * pm;
         Usum += sc->ke / sc->alpha * pm * delta;
-        if (ct_reserve(sc, sc->nc + 1)) return scerr(sc, ODHS_E_NOMEM, "out of memory (contact list)");
         sc->ci[sc->nc] = i;
         sc->cj[sc->nc] = j;
         for (int k = 0; k < d; ++k) sc->cr[sc->nc * d + k] = v[k];
@@ -370,6 +399,7 @@ static void sc_free_arrays(odhs_softcore *sc)
     }
     odhs__free(sc->pi);
     odhs__free(sc->pj);
+    odhs__free(sc->pk);
     odhs__free(sc->ci);
     odhs__free(sc->cj);
 }
@@ -649,6 +679,9 @@ static void snapshot(odhs_softcore *sc, double *gam, double *str, double *tim)
     *gam = sc->sys->gamma;
     *str = sc->strain;
     *tim = sc->time;
+    sc->nforce_s = sc->nforce;
+    sc->fc_ok_s = sc->fc_ok;
+    sc->h_ad_s = sc->h_ad;
 }
 
 static void rollback(odhs_softcore *sc, double gam, double str, double tim)
@@ -658,8 +691,12 @@ static void rollback(odhs_softcore *sc, double gam, double str, double tim)
     sc->sys->gamma = gam;
     sc->strain = str;
     sc->time = tim;
+    /* no evaluation completed since the snapshot: the cached forces and
+     * contacts are those of the restored positions */
+    sc->fc_ok = sc->nforce == sc->nforce_s ? sc->fc_ok_s : 0;
+    sc->nforce = sc->nforce_s;
+    sc->h_ad = sc->h_ad_s;
     sc->nb_ok = 0;
-    sc->fc_ok = 0;
 }
 
 static void advance_strain(odhs_softcore *sc, double dg)
@@ -1142,9 +1179,11 @@ static int eval_here(const odhs_softcore *csc, double *U, double *sig, double *m
 {
     odhs_softcore *sc = (odhs_softcore *)csc;
     int fc = sc->fc_ok;
+    uint64_t nf = sc->nforce;
     int s = elastic(sc, sc->sys->x, sc->w5, U, sig, mo);
     /* positions unchanged: the massive models' cached forces stay valid */
     sc->fc_ok = s == ODHS_OK ? fc : 0;
+    if (s != ODHS_OK) sc->nforce = nf; /* an error changes nothing visible */
     return s;
 }
 
