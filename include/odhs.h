@@ -15,5 +15,6 @@
 #include "odhs/walls.h"
 #include "odhs/jamming.h"
 #include "odhs/checkpoint.h"
+#include "odhs/softcore.h"
 
 #endif /* ODHS_H */

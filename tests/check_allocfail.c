@@ -416,6 +416,7 @@ typedef struct {
     odhs_solver *sol, *sol2;
     odhs_driver *drv, *drv2;
     odhs_stepper *st, *st2;
+    odhs_softcore *soft;
     double *b, *g, *x1, *x2, *x3, *x4; /* libc memory, not counted */
     size_t nc;
     unsigned char mark[64];
@@ -452,6 +453,7 @@ static void fix_init(af_fix *f)
 
 static void fix_destroy(af_fix *f)
 {
+    odhs_softcore_destroy(f->soft);
     odhs_stepper_destroy(f->st2);
     odhs_stepper_destroy(f->st);
     odhs_network_destroy(f->net);
@@ -1201,6 +1203,69 @@ static void walk(const af_scenario *sc)
     AF_MSG(af_failures == 0, "%s: %d failures (listed on stderr)", sc->name, af_failures);
 }
 
+/* -- softcore: RD0, CD0 and CD_n steps, a quasistatic SD step, observables --- */
+enum { SC_STEPS1 = 2, SC_CD0 = SC_STEPS1 + 4, SC_STEPS2, SC_MINTOL = SC_STEPS2 + 3, SC_QS, SC_CDN, SC_STEPS3,
+       SC_ENERGY = SC_STEPS3 + 3, SC_STRESS, SC_NOPS };
+
+static void soft_setup(af_fix *f, const af_scenario *sc)
+{
+    (void)sc;
+    f->sys = config_system(&cfg_dense);
+}
+
+static int soft_op(af_fix *f, const af_scenario *sc, int k)
+{
+    (void)sc;
+    if ((k >= SC_STEPS1 && k < SC_CD0) || (k >= SC_STEPS2 && k < SC_MINTOL) || (k >= SC_STEPS3 && k < SC_ENERGY))
+        return odhs_softcore_step(f->soft);
+    switch (k) {
+    case 0: return odhs_softcore_create(f->sys, &f->soft);
+    case 1: return odhs_softcore_set_shear_rate(f->soft, 1e-2);
+    case SC_CD0: return odhs_softcore_set_model(f->soft, ODHS_SOFTCORE_CD0);
+    case SC_MINTOL: return odhs_softcore_set_min_tolerance(f->soft, 1e-6, 1000000);
+    case SC_QS: return odhs_softcore_quasistatic_step(f->soft, 1e-3, NULL);
+    case SC_CDN: return odhs_softcore_set_model(f->soft, ODHS_SOFTCORE_CDN);
+    case SC_ENERGY: return odhs_softcore_energy(f->soft, &f->errs[0]);
+    case SC_STRESS: {
+        double sig[4];
+        int s = odhs_softcore_stress(f->soft, ODHS_SOFTCORE_STRESS_TOTAL, sig);
+        if (!s) f->errs[1] = sig[1];
+        return s;
+    }
+    }
+    return ODHS_E_INTERNAL;
+}
+
+static void soft_capture(const af_fix *f, const af_scenario *sc, int op, af_buf *b)
+{
+    (void)sc;
+    rec_system(b, "sys", f->sys);
+    rec_i(b, "handle", f->soft != NULL);
+    if (f->soft) {
+        double v[5];
+        uint64_t c[3];
+        odhs_softcore_time(f->soft, &v[0]);
+        odhs_softcore_strain(f->soft, &v[1]);
+        odhs_softcore_step_size(f->soft, &v[2]);
+        odhs_softcore_kinetic_energy(f->soft, &v[3]);
+        v[4] = 0.0;
+        rec(b, "soft", 'd', v, 5);
+        odhs_softcore_counts(f->soft, &c[0], &c[1], &c[2]);
+        double cd[3] = {(double)c[0], (double)c[1], (double)c[2]};
+        rec(b, "counts", 'd', cd, 3);
+    }
+    if (op < 0) rec(b, "errs", 'd', f->errs, 2);
+}
+
+static void soft_final(af_fix *f, const af_scenario *sc)
+{
+    AF_MSG(f->soft != NULL, "%s: no handle", sc->name);
+    for (int k = 0; k < 2; ++k) AF_OK(odhs_softcore_step(f->soft));
+    double U;
+    AF_OK(odhs_softcore_energy(f->soft, &U));
+    AF_MSG(U >= 0.0, "%s: energy %g", sc->name, U);
+}
+
 static const af_scenario scenarios[] = {
     {"build_2d", 8, 0, build_setup_none, NULL, build_op, build_capture, build_final},
     {"build_3d", 8, 1, build_setup_none, NULL, build_op, build_capture, build_final},
@@ -1214,6 +1279,7 @@ static const af_scenario scenarios[] = {
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"checkpoint", 3, 0, ckpt_setup, NULL, ckpt_op, ckpt_capture, ckpt_final},
+    {"softcore", SC_NOPS, 0, soft_setup, NULL, soft_op, soft_capture, soft_final},
 };
 #define AF_NSCEN ((int)(sizeof scenarios / sizeof scenarios[0]))
 

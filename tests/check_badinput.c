@@ -94,6 +94,7 @@ typedef struct {
     odhs_driver *drv, *drvr;
     odhs_solver *cg, *dense, *stsol, *solr;
     odhs_stepper *st, *run;
+    double x0[64], d0; /* scratch outputs of the softcore rows */
     char dir[64];
     int ok;
     char why[256];
@@ -1875,6 +1876,106 @@ static int huge_rate_case(void)
       return ckpt_parse_mutated(w, 2);)
 
 /* ---- regressions: bugs found by these rows and by fuzz_xyz ------------------- */
+#define SOFTCORE_CASES(X) \
+    X(sc_create_null_out, odhs_softcore_create, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_create(w->sys2, NULL);) \
+    X(sc_create_null_sys, odhs_softcore_create, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *s = POISON_PTR(odhs_softcore); int rc = odhs_softcore_create(NULL, &s); return s ? post("*out not NULL") : rc;) \
+    X(sc_create_unset, odhs_softcore_create, ODHS_E_STATE, NOALT, H_BARE, 0, odhs_softcore *s = POISON_PTR(odhs_softcore); int rc = odhs_softcore_create(w->bare, &s); return s ? post("*out not NULL") : rc;) \
+    X(sc_destroy_null, odhs_softcore_destroy, ODHS_OK, NOALT, H_NONE, 0, odhs_softcore_destroy(NULL); return ODHS_OK;) \
+    X(sc_errmsg_null, odhs_softcore_errmsg, ODHS_OK, NOALT, H_NONE, 0, const char *m = odhs_softcore_errmsg(NULL); return m && !m[0] ? ODHS_OK : post("errmsg(NULL)");) \
+    X(sc_set_model_null, odhs_softcore_set_model, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_model(NULL, ODHS_SOFTCORE_CD0);) \
+    X(sc_set_potential_null, odhs_softcore_set_potential, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_potential(NULL, 2.0, 1.0);) \
+    X(sc_set_drag_null, odhs_softcore_set_drag, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_drag(NULL, 1.0);) \
+    X(sc_set_substrate_null, odhs_softcore_set_substrate, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_substrate(NULL, 1.0);) \
+    X(sc_set_mass_null, odhs_softcore_set_mass, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_mass(NULL, 1.0);) \
+    X(sc_set_shear_rate_null, odhs_softcore_set_shear_rate, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_shear_rate(NULL, 1.0);) \
+    X(sc_set_integrator_null, odhs_softcore_set_integrator, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_integrator(NULL, ODHS_SOFTCORE_FIXED);) \
+    X(sc_set_dt_null, odhs_softcore_set_dt, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_dt(NULL, 0.1);) \
+    X(sc_set_tolerance_null, odhs_softcore_set_tolerance, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_tolerance(NULL, 1e-6);) \
+    X(sc_set_minimiser_null, odhs_softcore_set_minimiser, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_minimiser(NULL, ODHS_SOFTCORE_SD);) \
+    X(sc_set_min_tolerance_null, odhs_softcore_set_min_tolerance, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_min_tolerance(NULL, 1e-9, 10);) \
+    X(sc_set_linear_tolerance_null, odhs_softcore_set_linear_tolerance, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_linear_tolerance(NULL, 1e-10);) \
+    X(sc_set_positions_null, odhs_softcore_set_positions, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_positions(NULL, w->x0);) \
+    X(sc_set_velocities_null, odhs_softcore_set_velocities, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_velocities(NULL, w->x0);) \
+    X(sc_reset_null, odhs_softcore_reset, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_reset(NULL);) \
+    X(sc_step_null, odhs_softcore_step, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_step(NULL);) \
+    X(sc_run_until_strain_null, odhs_softcore_run_until_strain, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_run_until_strain(NULL, 0.1);) \
+    X(sc_run_until_time_null, odhs_softcore_run_until_time, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_run_until_time(NULL, 1.0);) \
+    X(sc_minimise_null, odhs_softcore_minimise, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_minimise(NULL, NULL);) \
+    X(sc_quasistatic_step_null, odhs_softcore_quasistatic_step, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_quasistatic_step(NULL, 1e-3, NULL);) \
+    X(sc_time_null, odhs_softcore_time, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_time(NULL, &w->d0);) \
+    X(sc_strain_null, odhs_softcore_strain, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_strain(NULL, &w->d0);) \
+    X(sc_counts_null, odhs_softcore_counts, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_counts(NULL, NULL, NULL, NULL);) \
+    X(sc_step_size_null, odhs_softcore_step_size, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_step_size(NULL, &w->d0);) \
+    X(sc_energy_null, odhs_softcore_energy, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_energy(NULL, &w->d0);) \
+    X(sc_kinetic_energy_null, odhs_softcore_kinetic_energy, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_kinetic_energy(NULL, &w->d0);) \
+    X(sc_forces_null, odhs_softcore_forces, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_forces(NULL, w->x0);) \
+    X(sc_max_force_null, odhs_softcore_max_force, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_max_force(NULL, &w->d0);) \
+    X(sc_velocities_null, odhs_softcore_velocities, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_velocities(NULL, w->x0);) \
+    X(sc_stress_null, odhs_softcore_stress, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_stress(NULL, ODHS_SOFTCORE_STRESS_TOTAL, w->x0);) \
+    X(sc_pressure_null, odhs_softcore_pressure, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_pressure(NULL, &w->d0);) \
+    X(sc_max_overlap_null, odhs_softcore_max_overlap, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_max_overlap(NULL, &w->d0);) \
+    X(sc_coordination_null, odhs_softcore_coordination, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_coordination(NULL, 0, &w->d0);) \
+    X(sc_relaxation_stress_null, odhs_softcore_relaxation_stress, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_relaxation_stress(NULL, w->x0);) \
+    X(sc_model_bad, odhs_softcore_set_model, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_model(sc, 6));) \
+    X(sc_model_neg, odhs_softcore_set_model, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_model(sc, -1));) \
+    X(sc_pot_alpha, odhs_softcore_set_potential, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_potential(sc, 1.0, 1.0));) \
+    X(sc_pot_ke, odhs_softcore_set_potential, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_potential(sc, 2.0, 0.0));) \
+    X(sc_pot_nan, odhs_softcore_set_potential, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_potential(sc, NAN_, 1.0));) \
+    X(sc_drag_neg, odhs_softcore_set_drag, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_drag(sc, -1.0));) \
+    X(sc_drag_inf, odhs_softcore_set_drag, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_drag(sc, INF_));) \
+    X(sc_sub_neg, odhs_softcore_set_substrate, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_substrate(sc, -1e-3));) \
+    X(sc_sub_nan, odhs_softcore_set_substrate, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_substrate(sc, NAN_));) \
+    X(sc_mass_zero, odhs_softcore_set_mass, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_mass(sc, 0.0));) \
+    X(sc_mass_nan, odhs_softcore_set_mass, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_mass(sc, NAN_));) \
+    X(sc_rate_nan, odhs_softcore_set_shear_rate, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_shear_rate(sc, NAN_));) \
+    X(sc_rate_huge, odhs_softcore_set_shear_rate, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_shear_rate(sc, 1e308));) \
+    X(sc_integ_bad, odhs_softcore_set_integrator, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_integrator(sc, 2));) \
+    X(sc_dt_zero, odhs_softcore_set_dt, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_dt(sc, 0.0));) \
+    X(sc_dt_big, odhs_softcore_set_dt, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_dt(sc, 11.0));) \
+    X(sc_dt_nan, odhs_softcore_set_dt, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_dt(sc, NAN_));) \
+    X(sc_tol_one, odhs_softcore_set_tolerance, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_tolerance(sc, 1.0));) \
+    X(sc_tol_nan, odhs_softcore_set_tolerance, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_tolerance(sc, NAN_));) \
+    X(sc_min_bad, odhs_softcore_set_minimiser, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_minimiser(sc, 3));) \
+    X(sc_mintol_zero, odhs_softcore_set_min_tolerance, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_min_tolerance(sc, 0.0, 10));) \
+    X(sc_mintol_iter, odhs_softcore_set_min_tolerance, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_min_tolerance(sc, 1e-9, 0));) \
+    X(sc_mintol_nan, odhs_softcore_set_min_tolerance, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_min_tolerance(sc, NAN_, 10));) \
+    X(sc_ltol_zero, odhs_softcore_set_linear_tolerance, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_linear_tolerance(sc, 0.0));) \
+    X(sc_ltol_nan, odhs_softcore_set_linear_tolerance, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_linear_tolerance(sc, NAN_));) \
+    X(sc_pos_nullx, odhs_softcore_set_positions, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_positions(sc, NULL));) \
+    X(sc_pos_nan, odhs_softcore_set_positions, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_pos_nan(w, sc));) \
+    X(sc_pos_far, odhs_softcore_set_positions, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_pos_far(w, sc));) \
+    X(sc_vel_nullu, odhs_softcore_set_velocities, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_velocities(sc, NULL));) \
+    X(sc_vel_nan, odhs_softcore_set_velocities, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_vel_nan(sc));) \
+    X(sc_step_rd0_nodrag, odhs_softcore_step, ODHS_E_UNSUPPORTED, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, (odhs_softcore_set_drag(sc, 0.0), odhs_softcore_step(sc)));) \
+    X(sc_step_cd0_nok0, odhs_softcore_step, ODHS_E_UNSUPPORTED, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, (odhs_softcore_set_model(sc, ODHS_SOFTCORE_CD0), odhs_softcore_set_substrate(sc, 0.0), odhs_softcore_step(sc)));) \
+    X(sc_strain_norate, odhs_softcore_run_until_strain, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_run_until_strain(sc, 0.1));) \
+    X(sc_strain_behind, odhs_softcore_run_until_strain, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, (odhs_softcore_set_shear_rate(sc, 1.0), odhs_softcore_run_until_strain(sc, -0.1)));) \
+    X(sc_strain_nan, odhs_softcore_run_until_strain, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_run_until_strain(sc, NAN_));) \
+    X(sc_time_behind, odhs_softcore_run_until_time, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_run_until_time(sc, -1.0));) \
+    X(sc_time_nan, odhs_softcore_run_until_time, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_run_until_time(sc, NAN_));) \
+    X(sc_minimise_noconv, odhs_softcore_minimise, ODHS_E_NOCONV, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_noconv(w, sc));) \
+    X(sc_minimise_nodrag, odhs_softcore_minimise, ODHS_E_UNSUPPORTED, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, (odhs_softcore_set_drag(sc, 0.0), sc_noconv(w, sc)));) \
+    X(sc_qs_zero, odhs_softcore_quasistatic_step, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_quasistatic_step(sc, 0.0, NULL));) \
+    X(sc_qs_big, odhs_softcore_quasistatic_step, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_quasistatic_step(sc, 0.2, NULL));) \
+    X(sc_qs_nan, odhs_softcore_quasistatic_step, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_quasistatic_step(sc, NAN_, NULL));) \
+    X(sc_time_nullout, odhs_softcore_time, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_time(sc, NULL));) \
+    X(sc_strain_nullout, odhs_softcore_strain, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_strain(sc, NULL));) \
+    X(sc_step_size_nullout, odhs_softcore_step_size, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_step_size(sc, NULL));) \
+    X(sc_energy_nullout, odhs_softcore_energy, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_energy(sc, NULL));) \
+    X(sc_kinetic_energy_nullout, odhs_softcore_kinetic_energy, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_kinetic_energy(sc, NULL));) \
+    X(sc_max_force_nullout, odhs_softcore_max_force, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_max_force(sc, NULL));) \
+    X(sc_pressure_nullout, odhs_softcore_pressure, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_pressure(sc, NULL));) \
+    X(sc_max_overlap_nullout, odhs_softcore_max_overlap, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_max_overlap(sc, NULL));) \
+    X(sc_forces_nullout, odhs_softcore_forces, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_forces(sc, NULL));) \
+    X(sc_vels_nullout, odhs_softcore_velocities, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_velocities(sc, NULL));) \
+    X(sc_stress_nullout, odhs_softcore_stress, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_stress(sc, ODHS_SOFTCORE_STRESS_TOTAL, NULL));) \
+    X(sc_stress_part, odhs_softcore_stress, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_stress(sc, 4, w->x0));) \
+    X(sc_coord_nullout, odhs_softcore_coordination, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_coordination(sc, 1, NULL));) \
+    X(sc_relax_state, odhs_softcore_relaxation_stress, ODHS_E_STATE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_relaxation_stress(sc, w->x0));) \
+    X(sc_relax_nullout, odhs_softcore_relaxation_stress, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_relaxation_stress(sc, NULL));) \
+    X(sc_reset_ok, odhs_softcore_reset, ODHS_OK, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_reset(sc));) \
+    X(sc_counts_ok, odhs_softcore_counts, ODHS_OK, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_counts(sc));)
+
 #define REGRESSION_CASES(X)                                                                             \
     X(reg_wrap_far_positions, odhs_system_set_configuration, ODHS_OK, NOALT, H_NONE, F_NOPROBE,                \
       /* system.h: positions passed in are wrapped into [0,Lx) x [0,Ly); coordinates more than 2^50 box     \
@@ -1904,6 +2005,61 @@ static int huge_rate_case(void)
       for (size_t c = 0; rc == ODHS_OK && c < odhs_network_count(odhs_stepper_network(w->run)); ++c)           \
           if (!isfinite(x[c])) return post("OK with a non-finite solution");                                   \
       return rc;)
+
+/* softcore rows: a handle on sys2 made for the row; the bad call must leave a
+ * message on it; create/destroy do not change sys2 */
+static odhs_softcore *sc_new(world *w)
+{
+    odhs_softcore *sc = NULL;
+    return odhs_softcore_create(w->sys2, &sc) == ODHS_OK ? sc : NULL;
+}
+static int sc_done(odhs_softcore *sc, int rc)
+{
+    int msg = odhs_softcore_errmsg(sc)[0] != '\0';
+    odhs_softcore_destroy(sc);
+    if (rc < 0 && !msg) return post("error %d without a message on the softcore handle", rc);
+    return rc;
+}
+static int sc_pos_nan(world *w, odhs_softcore *sc)
+{
+    odhs_system_get_positions(w->sys2, w->x0);
+    w->x0[5] = NAN_;
+    return odhs_softcore_set_positions(sc, w->x0);
+}
+static int sc_pos_far(world *w, odhs_softcore *sc)
+{
+    odhs_system_get_positions(w->sys2, w->x0);
+    w->x0[3] = 1e300;
+    return odhs_softcore_set_positions(sc, w->x0);
+}
+static int sc_vel_nan(odhs_softcore *sc)
+{
+    double u[32] = {0};
+    u[7] = INF_;
+    return odhs_softcore_set_velocities(sc, u);
+}
+/* a minimisation that cannot converge in one iteration: overlaps made by an
+ * affine shear of the handle's own copy of the state; rolled back, so the
+ * system (sys2) is unchanged */
+static int sc_noconv(world *w, odhs_softcore *sc)
+{
+    double x[32], y[32];
+    odhs_system_get_positions(w->sys2, x);
+    memcpy(y, x, sizeof y);
+    y[2] = x[0] + 0.3; /* particle 1 onto particle 0: a large overlap */
+    y[3] = x[1];
+    odhs_softcore_set_min_tolerance(sc, 1e-300, 1);
+    odhs_softcore_set_positions(sc, y);
+    int rc = odhs_softcore_minimise(sc, NULL);
+    odhs_softcore_set_positions(sc, x); /* sys2 back bit for bit */
+    return rc;
+}
+static int sc_counts(odhs_softcore *sc)
+{
+    uint64_t a = 1, b = 1, c = 1;
+    int rc = odhs_softcore_counts(sc, &a, &b, &c);
+    return rc == ODHS_OK && a == 0 && c == 0 ? ODHS_OK : post("counts of a new handle not zero");
+}
 
 /* ---- table machinery ------------------------------------------------------------ */
 typedef int (*bad_fn)(world *w);
@@ -1938,6 +2094,7 @@ DRIVER_CASES(X_DEFINE)
 STEPPER_CASES(X_DEFINE)
 JAMMING_CASES(X_DEFINE)
 CHECKPOINT_CASES(X_DEFINE)
+SOFTCORE_CASES(X_DEFINE)
 REGRESSION_CASES(X_DEFINE)
 
 static const bad_case common_cases[] = {COMMON_CASES(X_ROW)};
@@ -1949,6 +2106,7 @@ static const bad_case driver_cases[] = {DRIVER_CASES(X_ROW)};
 static const bad_case stepper_cases[] = {STEPPER_CASES(X_ROW)};
 static const bad_case jamming_cases[] = {JAMMING_CASES(X_ROW)};
 static const bad_case checkpoint_cases[] = {CHECKPOINT_CASES(X_ROW)};
+static const bad_case softcore_cases[] = {SOFTCORE_CASES(X_ROW)};
 static const bad_case regression_cases[] = {REGRESSION_CASES(X_ROW)};
 
 #define NROWS(t) ((int)(sizeof t / sizeof t[0]))
@@ -1961,7 +2119,8 @@ static const struct {
     {io_cases, NROWS(io_cases)},           {network_cases, NROWS(network_cases)},
     {solver_cases, NROWS(solver_cases)},   {driver_cases, NROWS(driver_cases)},
     {stepper_cases, NROWS(stepper_cases)}, {jamming_cases, NROWS(jamming_cases)},
-    {checkpoint_cases, NROWS(checkpoint_cases)}, {regression_cases, NROWS(regression_cases)},
+    {checkpoint_cases, NROWS(checkpoint_cases)}, {softcore_cases, NROWS(softcore_cases)},
+    {regression_cases, NROWS(regression_cases)},
 };
 
 static int mkdir_p(const char *p)
@@ -2035,6 +2194,7 @@ TABLE_TEST(test_driver, driver_cases)
 TABLE_TEST(test_stepper, stepper_cases)
 TABLE_TEST(test_jamming, jamming_cases)
 TABLE_TEST(test_checkpoint, checkpoint_cases)
+TABLE_TEST(test_softcore, softcore_cases)
 TABLE_TEST(test_regression, regression_cases)
 
 /* ---- coverage: every function declared in the public headers has a row ----- */
@@ -2132,6 +2292,7 @@ Suite *make_badinput_suite(void)
         {"solver", test_solver, NROWS(solver_cases)},       {"driver", test_driver, NROWS(driver_cases)},
         {"stepper", test_stepper, NROWS(stepper_cases)},    {"jamming", test_jamming, NROWS(jamming_cases)},
         {"checkpoint", test_checkpoint, NROWS(checkpoint_cases)},
+        {"softcore", test_softcore, NROWS(softcore_cases)},
         {"regression", test_regression, NROWS(regression_cases)},
     };
     for (size_t k = 0; k < sizeof tcs / sizeof tcs[0]; ++k) {

@@ -103,5 +103,21 @@ expect 2 "sweep_serial strain within the transient" -- "$bin/sweep_serial" --cam
 expect 0 "sweep_serial built-in campaign" -- "$bin/sweep_serial" --out "$tmp/sw" --quiet
 [ "$(grep -c ',ok,' "$tmp/sw/runs.csv")" -eq 4 ] && [ -s "$tmp/sw/eta_phi.svg" ] && pass=$((pass + 1)) \
     || { echo "FAIL: sweep_serial built-in campaign results"; fail=$((fail + 1)); }
+expect 0 "softcore_shear help" -- "$bin/softcore_shear" --help
+expect_in out "usage: softcore_shear" "softcore_shear --help prints usage"
+expect 2 "softcore_shear unknown option" -- "$bin/softcore_shear" --no-such-option
+expect 2 "softcore_shear bad model" -- "$bin/softcore_shear" --model hard
+expect 2 "softcore_shear bad rate" -- "$bin/softcore_shear" --rate -1
+expect 1 "softcore_shear unreadable input" -- "$bin/softcore_shear" --in "$tmp/does-not-exist.xyz"
+expect 0 "softcore_shear rd0 from a file" -- "$bin/softcore_shear" --in "$tmp/c.xyz" --strain 0.002 --every 0.001 \
+    --series "$tmp/sc.csv" --out "$tmp/sc.xyz"
+expect_in sc.csv "^strain,shear_stress,pressure,energy,z,max_overlap" "softcore_shear writes its series header"
+[ "$(wc -l < "$tmp/sc.csv")" -eq 4 ] && pass=$((pass + 1)) || { echo "FAIL: softcore_shear series rows"; fail=$((fail + 1)); }
+for m in cd0 qs-sd qs-fire qs-cg rd cd cdn cdt; do
+    expect 0 "softcore_shear --model $m" -- "$bin/softcore_shear" --in "$tmp/c.xyz" --model $m --rate 1e-3 \
+        --dgamma 1e-3 --strain 0.002 --every 0.001
+done
+expect 0 "softcore_shear 3D hertzian adaptive" -- "$bin/softcore_shear" --dim 3 --n 32 --phi 0.4 --alpha 2.5 \
+    --integrator adaptive --strain 0.002 --every 0.001 --rate 1e-3
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
