@@ -261,6 +261,7 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     odhs_driver *drv = NULL;
     odhs_stepper *st = NULL;
     double *tmpF = NULL;
+    if (errbuf && errlen) errbuf[0] = '\0'; /* "" on success, like the XYZ reader */
     if (sys_out) *sys_out = NULL;
     if (drv_out) *drv_out = NULL;
     if (st_out) *st_out = NULL;
@@ -373,10 +374,17 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     st->nb_stale = (int)stale;
     double sc[] = {st->dt, st->tol, st->h, st->lambda, st->contact_tol, st->time, st->strain, st->tau,
                    st->kappa, st->skin, st->rc};
-    if (!finite_all(sc, sizeof sc / sizeof sc[0]) || !finite_all(st->G, 9) || !finite_all(st->M, 9) ||
-        !finite_all(st->U, nd) || !finite_all(st->disp, nd) || !(st->dt > 0) || !(st->tol > 0 && st->tol < 1) ||
-        !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) || !(st->skin > 0) || st->contact_tol < 0)
-        FAIL(ODHS_E_FORMAT, "checkpoint: invalid stepper values");
+    static const char *const scn[] = {"dt", "tol", "h", "lambda", "contact_tol", "time", "strain", "tau",
+                                      "kappa", "skin", "rc"};
+    for (size_t k = 0; k < sizeof sc / sizeof sc[0]; ++k)
+        if (!isfinite(sc[k])) FAIL(ODHS_E_FORMAT, "checkpoint: stepper value %s is not finite", scn[k]);
+    if (!finite_all(st->G, 9) || !finite_all(st->M, 9) || !finite_all(st->U, nd) || !finite_all(st->disp, nd))
+        FAIL(ODHS_E_FORMAT, "checkpoint: non-finite number in the stepper section");
+    if (!(st->dt > 0) || !(st->tol > 0 && st->tol < 1) || !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) ||
+        !(st->skin > 0) || st->contact_tol < 0)
+        FAIL(ODHS_E_FORMAT,
+             "checkpoint: invalid stepper values (dt %g, tol %g, h %g, tau %g, lambda %g, skin %g, contact_tol %g)",
+             st->dt, st->tol, st->h, st->tau, st->lambda, st->skin, st->contact_tol);
     if (npairs) {
         size_t *a = odhs__realloc(st->pi, (size_t)npairs * sizeof *a);
         if (a) st->pi = a;
@@ -436,6 +444,7 @@ int odhs_checkpoint_read(const char *path, odhs_solver *solver, odhs_system **sy
     if (sys) *sys = NULL;
     if (drv) *drv = NULL;
     if (st) *st = NULL;
+    if (errbuf && errlen) errbuf[0] = '\0';
     if (!path) {
         if (errbuf && errlen) snprintf(errbuf, errlen, "checkpoint: path is NULL");
         return ODHS_E_NULL;

@@ -818,6 +818,12 @@ static int restart_step(odhs_stepper *st)
  * difference between the Euler and Heun non-affine displacements,
  * tau/2 max_i |U*_i - U0_i|, relative to the mean diameter. On return *Ga, st->Ua
  * hold the chord's gradient and velocities and *tau the accepted step. */
+/* Smallest adaptive step, relative to dt: without a floor an accepted step
+ * with an infinite error estimate (fac = 0) or repeated rejections from a
+ * tiny h set h to 0 and the integrator stalls forever (found by fuzzing the
+ * checkpoint reader). */
+#define HEUN_HMIN 1e-12
+
 static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
 {
     odhs_system *sys = st->sys;
@@ -877,12 +883,12 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
             for (size_t k = 0; k < nd; ++k) st->Ua[k] = 0.5 * (st->U0[k] + st->U[k]);
             for (int a = 0; a < 9; ++a) Ga[a] = 0.5 * (G0[a] + Gs[a]);
             memcpy(st->U, st->U0, nd * sizeof *st->U);
-            if (!truncated) st->h = fmin(st->dt, st->h * fmin(2.0, fac));
+            if (!truncated) st->h = fmin(st->dt, fmax(st->h * fmin(2.0, fac), HEUN_HMIN * st->dt));
             *tau_out = tau;
             return ODHS_OK;
         }
         st->nrejected++;
-        st->h *= fmax(0.2, fac);
+        st->h = fmax(st->h * fmax(0.2, fac), HEUN_HMIN * st->dt);
     }
 }
 

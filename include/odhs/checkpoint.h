@@ -40,7 +40,8 @@ ODHS_API int odhs_checkpoint_write(const odhs_stepper *st, const char *path);
 /**
  * Restore a checkpoint: creates a new system, driver and stepper (the stepper
  * borrows the other two and the given solver; destroy the stepper first).
- * On error all outputs are NULL and errbuf (may be NULL) holds a message.
+ * On error all outputs are NULL and errbuf (may be NULL) holds a message;
+ * on success errbuf holds "" (empty string).
  * Errors: ODHS_E_NULL, ODHS_E_IO, ODHS_E_FORMAT (bad magic, version,
  * checksum, sizes or values), ODHS_E_NOMEM.
  */
