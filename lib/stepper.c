@@ -133,6 +133,9 @@ static int compute_forces(odhs_stepper *st)
     if (!drv->pressure_on) {
         set_gradient(st, drv->crate);
         st->kappa = drv->gdot != 0.0 ? drv->crate / drv->gdot : drv->crate;
+        /* a subnormal shear rate overflows the ratio (found by fuzzing the
+         * checkpoint reader): report c as without shear, never inf */
+        if (!isfinite(st->kappa)) st->kappa = drv->crate;
     }
     if (nc == 0) {
         if (drv->pressure_on) {
