@@ -163,6 +163,11 @@ struct odhs_solver {
     double nsolves;
     double *work;    /* residual check */
     size_t work_cap;
+    /* fallback (odhs_solver_set_fallback): borrowed solver tried when a solve
+     * fails with ODHS_E_NOCONV or ODHS_E_SINGULAR */
+    struct odhs_solver *fallback;
+    double nfallbacks, nrescued; /* solves handed over / rescued by it */
+    int last_fallback;           /* the last solve was handed over */
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
