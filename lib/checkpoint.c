@@ -379,7 +379,9 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     for (size_t k = 0; k < sizeof sc / sizeof sc[0]; ++k)
         if (!isfinite(sc[k])) FAIL(ODHS_E_FORMAT, "checkpoint: stepper value %s is not finite", scn[k]);
     if (!finite_all(st->G, 9) || !finite_all(st->M, 9) || !finite_all(st->U, nd) || !finite_all(st->disp, nd))
-        FAIL(ODHS_E_FORMAT, "checkpoint: non-finite number in the stepper section");
+        FAIL(ODHS_E_FORMAT, "checkpoint: non-finite number in the stepper section (%s)",
+             !finite_all(st->G, 9) ? "velocity gradient" : !finite_all(st->M, 9) ? "cell matrix"
+             : !finite_all(st->U, nd) ? "velocities" : "displacements");
     if (!(st->dt > 0) || !(st->tol > 0 && st->tol < 1) || !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) ||
         !(st->skin > 0) || st->contact_tol < 0)
         FAIL(ODHS_E_FORMAT,

@@ -250,8 +250,9 @@ struct odhs_stepper {
     size_t nrem, remcap;
     odhs_change *chg;
     size_t nchg, chgcap;
-    /* rollback snapshot */
-    double *xs;
+    /* rollback snapshot: xs holds 3 nd doubles, positions then Us, Fs */
+    double *xs, *Us, *Fs; /* Us, Fs: velocities and external forces */
+    int has_Fs;
     double Ls[3], gammas, times, strains, kappas;
     uint64_t nsteps_s;
     double Gs[9];

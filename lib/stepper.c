@@ -505,6 +505,9 @@ static int snapshot(odhs_stepper *st)
         st->scap = cap;
     }
     memcpy(st->xs, st->sys->x, st->nd * sizeof *st->xs);
+    memcpy(st->Us, st->U, st->nd * sizeof *st->Us);
+    memcpy(st->Fs, st->F, st->nd * sizeof *st->Fs);
+    st->has_Fs = st->has_F;
     memcpy(st->Ls, st->sys->L, sizeof st->Ls);
     st->gammas = st->sys->gamma;
     st->times = st->time;
@@ -543,8 +546,13 @@ static void rollback(odhs_stepper *st)
     odhs__net_geometry(net, st->sys);
     memcpy(st->G, st->Gs, sizeof st->G);
     st->kappa = st->kappas;
-    /* velocities from the restored forces */
-    if (eval_forces(st) == ODHS_OK) compute_velocities(st);
+    /* velocities and external forces as they were (recomputing them from the
+     * restored contact forces could call a failing force callback again, and
+     * gave non-finite velocities for a restored checkpoint whose forces
+     * overflow S^T f: found by fuzz_checkpoint) */
+    memcpy(st->U, st->Us, st->nd * sizeof *st->U);
+    memcpy(st->F, st->Fs, st->nd * sizeof *st->F);
+    st->has_F = st->has_Fs;
     st->nb_stale = 1; /* rebuild the neighbour list before the next step */
 }
 
@@ -573,7 +581,11 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->U = odhs__calloc(st->nd, sizeof(double));
     st->tmp = odhs__calloc(st->nd, sizeof(double));
     st->disp = odhs__calloc(st->nd, sizeof(double));
-    st->xs = odhs__calloc(st->nd, sizeof(double));
+    st->xs = odhs__calloc(3 * st->nd, sizeof(double));
+    if (st->xs) {
+        st->Us = st->xs + st->nd;
+        st->Fs = st->xs + 2 * st->nd;
+    }
     st->U0 = odhs__calloc(st->nd, sizeof(double));
     st->Ua = odhs__calloc(st->nd, sizeof(double));
     st->disps = odhs__calloc(st->nd, sizeof(double));
