@@ -23,6 +23,8 @@
  *     again: ODHS_JAMMED with a clean certificate is then the end).
  *   - large_n_{2d,3d}: N = 10^4 random packings (phi = 0.5 / 0.3) sheared
  *     for 30 steps: invariants after every step.
+ *   - subnormal_shear_rate: gammadot = 1e-320 with compression: kappa is c
+ *     (it overflowed to inf) and the run equals pure compression.
  *
  * Copyright (C) 2026 the libodhs authors. LGPL-2.1-or-later, see LICENSE.
  */
@@ -503,6 +505,40 @@ END_TEST
 START_TEST(large_n_3d) { large_n(3); }
 END_TEST
 
+/* A subnormal shear rate with compression: kappa = c / gammadot overflowed
+ * to inf (then saved into a checkpoint that could not be read back; found by
+ * fuzz_checkpoint). The library reports kappa = c, as without shear. */
+START_TEST(subnormal_shear_rate)
+{
+    odhs_system *sys = packing(2, 16, 0.5, 1.4, 0.03, 0.4, 0, 71);
+    size_t nd = 2 * odhs_system_count(sys);
+    srun r, q;
+    srun_open(&r, sys, "dense", 1e-320);
+    srun_open(&q, sys, "dense", 0.0); /* pure compression: the reference */
+    OK(odhs_driver_set_compression_rate(r.drv, 0.5));
+    OK(odhs_driver_set_compression_rate(q.drv, 0.5));
+    for (int k = 0; k < 20; ++k) {
+        OKST(r.st, odhs_stepper_step(r.st, NULL));
+        OKST(q.st, odhs_stepper_step(q.st, NULL));
+    }
+    double kr, kq;
+    OK(odhs_stepper_kappa(r.st, &kr));
+    OK(odhs_stepper_kappa(q.st, &kq));
+    ck_assert_msg(kr == 0.5 && kq == 0.5, "kappa %.17g (gammadot 1e-320) and %.17g (no shear), c = 0.5", kr, kq);
+    /* a shear rate of 1e-320 moves nothing at double precision */
+    double *xr = malloc(nd * sizeof *xr), *xq = malloc(nd * sizeof *xq), d = 0.0;
+    OK(odhs_system_get_positions(r.sys, xr));
+    OK(odhs_system_get_positions(q.sys, xq));
+    for (size_t k = 0; k < nd; ++k) d = fmax(d, fabs(xr[k] - xq[k]));
+    ck_assert_msg(d <= 1e-14, "positions differ from pure compression by %.3g", d);
+    free(xr);
+    free(xq);
+    srun_close(&r);
+    srun_close(&q);
+    odhs_system_destroy(sys);
+}
+END_TEST
+
 Suite *make_extremes_suite(void)
 {
     Suite *s = suite_create("extremes");
@@ -520,6 +556,7 @@ Suite *make_extremes_suite(void)
     tcase_add_test(tc, near_jamming_3d);
     tcase_add_test(tc, large_n_2d);
     tcase_add_test(tc, large_n_3d);
+    tcase_add_test(tc, subnormal_shear_rate);
     suite_add_tcase(s, tc);
     return s;
 }
