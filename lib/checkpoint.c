@@ -12,6 +12,11 @@
 
 static const char MAGIC[8] = {'O', 'D', 'H', 'S', 'C', 'K', 'P', 'T'};
 
+/* largest |gap| / (a_i + a_j) of a contact in a readable checkpoint: far above
+ * any drift between corrections (about 1e-4 at dt = 1e-3, see
+ * docs/reliability.md), far below gaps that are not contacts */
+#define CKPT_MAX_CONTACT_GAP 0.1
+
 /* ---- byte buffer (writer) ------------------------------------------------ */
 typedef struct {
     unsigned char *p;
@@ -79,6 +84,14 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
     const odhs_driver *drv = st->drv;
     const odhs_network *net = st->net;
     size_t n = sys->n, nd = st->nd;
+    /* never write what the reader refuses */
+    for (size_t c = 0; c < net->nc; ++c) {
+        size_t i = net->ci[c], j = net->cj[c];
+        if (!(fabs(net->gap[c]) <= CKPT_MAX_CONTACT_GAP * (sys->r[i] + sys->r[j])))
+            return odhs__err(mst->errmsg, ODHS_E_STATE,
+                             "checkpoint: contact (%zu,%zu) has a gap of %.3g contact distances: not a valid state", i,
+                             j, net->gap[c] / (sys->r[i] + sys->r[j]));
+    }
     wbuf b = {NULL, 0, 0, 0};
     put(&b, MAGIC, 8);
     put_u64(&b, ODHS_CHECKPOINT_VERSION);
@@ -311,6 +324,15 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         FAIL(ODHS_E_FORMAT, "checkpoint: strain outside its remapped range");
     for (size_t i = 0; i < nd; ++i)
         if (sys->x[i] < 0.0 || sys->x[i] >= sys->L[i % dim]) FAIL(ODHS_E_FORMAT, "checkpoint: position outside the box");
+    /* species labels as odhs_system_set_species accepts them (an empty or
+     * blank label made an XYZ file that could not be read back: found by
+     * fuzz_checkpoint); the bytes after the terminator are kept */
+    for (size_t i = 0; i < n; ++i) {
+        char lab[ODHS_SPECIES_MAX + 1];
+        memcpy(lab, sys->species[i], sizeof lab);
+        if (odhs_system_set_species(sys, i, lab))
+            FAIL(ODHS_E_FORMAT, "checkpoint: species label of particle %zu is not valid", i);
+    }
     sys->rmax = rmax;
     sys->has_r = sys->has_x = 1;
     /* driver */
@@ -420,6 +442,16 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     }
     if (b.pos != b.len) FAIL(ODHS_E_FORMAT, "checkpoint: unexpected trailing data");
     odhs__net_geometry(st->net, sys);
+    /* a contact is a pair at contact distance, up to the integrator's drift:
+     * far-apart "contacts" act as rigid bonds and the drift correction would
+     * move their particles into others (found by fuzz_checkpoint) */
+    for (size_t c = 0; c < st->net->nc; ++c) {
+        size_t i = st->net->ci[c], j = st->net->cj[c];
+        if (!(fabs(st->net->gap[c]) <= CKPT_MAX_CONTACT_GAP * (sys->r[i] + sys->r[j])))
+            FAIL(ODHS_E_FORMAT, "checkpoint: contact (%zu,%zu) has a gap of %.3g contact distances", i, j,
+                 st->net->gap[c] / (sys->r[i] + sys->r[j]));
+    }
+    if (odhs__stepper_check_neighbours(st)) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
     if (drv->F) {
         memcpy(st->F, drv->F, nd * sizeof *st->F);
         st->has_F = 1;

@@ -148,6 +148,10 @@ void odhs__net_S(const odhs_network *net, const double *v, double *out);
 void odhs__net_ST(const odhs_network *net, const double *f, double *out);
 void odhs__net_N(const odhs_network *net, const double *x, double *out, double *work);
 
+/* restored stepper: mark the neighbour list stale unless it holds every pair
+ * closer than the unused skin (lib/stepper.c); ODHS_OK or ODHS_E_NOMEM */
+int odhs__stepper_check_neighbours(odhs_stepper *st);
+
 /* ---- solver handle ----------------------------------------------------------- */
 struct odhs_solver {
     const odhs_solver_type *type;

@@ -395,6 +395,61 @@ static double skin_used(const odhs_stepper *st)
     return 2.0 * sqrt(dmax) + frob(MI) * st->rc;
 }
 
+/* ---- neighbour list of a restored state ------------------------------------
+ * A checkpoint stores the neighbour list and its bookkeeping so that a
+ * continued run is bit-identical. A list that misses a pair closer than the
+ * unused skin (a corrupted file: found by fuzz_checkpoint, which then stepped
+ * particles deep into each other) is not trusted: the list is marked stale and
+ * rebuilt before the next step. */
+typedef struct {
+    const size_t *keys; /* sorted i * n + j of the stored pairs */
+    size_t nkeys, n;
+    int missing;
+} nbcheck_ctx;
+
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static int nbcheck_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    (void)gap;
+    nbcheck_ctx *c = vctx;
+    size_t key = (i < j ? i : j) * c->n + (i < j ? j : i);
+    if (!bsearch(&key, c->keys, c->nkeys, sizeof key, cmp_size)) {
+        c->missing = 1;
+        return 1;
+    }
+    return 0;
+}
+
+int odhs__stepper_check_neighbours(odhs_stepper *st)
+{
+    if (st->nb_stale) return ODHS_OK;
+    odhs_system *s = st->sys;
+    double room = st->skin - skin_used(st);
+    /* rc as build_neighbours sets it; the list must hold every pair closer
+     * than the skin not used up yet */
+    if (!(st->rc == 2.0 * s->rmax + st->skin) || !isfinite(room)) {
+        st->nb_stale = 1;
+        return ODHS_OK;
+    }
+    if (room <= 0.0) return ODHS_OK; /* the next step rebuilds it anyway */
+    size_t *keys = odhs__malloc_array(st->npairs ? st->npairs : 1, sizeof *keys);
+    if (!keys) return ODHS_E_NOMEM;
+    for (size_t p = 0; p < st->npairs; ++p) keys[p] = st->pi[p] * st->n + st->pj[p];
+    qsort(keys, st->npairs, sizeof *keys, cmp_size);
+    nbcheck_ctx c = {keys, st->npairs, st->n, 0};
+    int r = odhs__pairs(st->dim, st->n, s->x, s->r, s->rmax, s->L, s->gamma, room * (1.0 - 1e-9), nbcheck_cb, &c);
+    odhs__free(keys);
+    if (r == ODHS_E_NOMEM) return ODHS_E_NOMEM;
+    if (r || c.missing) st->nb_stale = 1;
+    return ODHS_OK;
+}
+
 /* rate at which skin_used can grow while moving with velocity field (G, vel) */
 static double skin_rate(const odhs_stepper *st, const double *G, const double *vel)
 {
