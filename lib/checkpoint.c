@@ -320,6 +320,12 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     }
     for (size_t k = 0; k < dim; ++k)
         if (!(sys->L[k] >= 4.0 * rmax)) FAIL(ODHS_E_FORMAT, "checkpoint: box edge %zu too small", k);
+    /* the aspect-ratio rule of the system setters (lib/system.c, check_box):
+     * an XYZ file of a box outside it could not be read back (found by
+     * fuzz_checkpoint) */
+    if (!(sys->L[0] / sys->L[1] > 1e-100 && sys->L[0] / sys->L[1] < 1e100))
+        FAIL(ODHS_E_FORMAT, "checkpoint: box aspect ratio Lx/Ly = %g out of range [1e-100, 1e100]",
+             sys->L[0] / sys->L[1]);
     if (fabs(sys->gamma) > 0.5 * sys->L[0] / sys->L[1] * (1 + 1e-12))
         FAIL(ODHS_E_FORMAT, "checkpoint: strain outside its remapped range");
     for (size_t i = 0; i < nd; ++i)

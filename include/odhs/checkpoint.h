@@ -45,6 +45,7 @@ ODHS_API int odhs_checkpoint_write(const odhs_stepper *st, const char *path);
  * on success errbuf holds "" (empty string).
  * Errors: ODHS_E_NULL, ODHS_E_IO, ODHS_E_FORMAT (bad magic, version,
  * checksum, sizes or values: non-finite numbers, positions outside the box,
+ * box edges or aspect ratio that odhs_system_set_box refuses,
  * species labels that odhs_system_set_species refuses, contacts farther than
  * 10% from contact distance, duplicated contacts), ODHS_E_NOMEM. A stored
  * neighbour list that misses a close pair is not trusted: it is rebuilt
