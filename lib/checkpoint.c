@@ -12,6 +12,11 @@
 
 static const char MAGIC[8] = {'O', 'D', 'H', 'S', 'C', 'K', 'P', 'T'};
 
+/* largest |gap| / (a_i + a_j) of a contact in a readable checkpoint: far above
+ * any drift between corrections (about 1e-4 at dt = 1e-3, see
+ * docs/reliability.md), far below gaps that are not contacts */
+#define CKPT_MAX_CONTACT_GAP 0.1
+
 /* ---- byte buffer (writer) ------------------------------------------------ */
 typedef struct {
     unsigned char *p;
@@ -79,6 +84,15 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
     const odhs_driver *drv = st->drv;
     const odhs_network *net = st->net;
     size_t n = sys->n, nd = st->nd;
+    /* never write what the reader refuses */
+    for (size_t c = 0; c < net->nc; ++c) {
+        size_t i = net->ci[c], j = net->cj[c];
+        double sig = odhs__net_sigma(net, sys, c);
+        if (!(fabs(net->gap[c]) <= CKPT_MAX_CONTACT_GAP * sig))
+            return odhs__err(mst->errmsg, ODHS_E_STATE,
+                             "checkpoint: contact (%zu,%zu) has a gap of %.3g contact distances: not a valid state", i,
+                             j, net->gap[c] / sig);
+    }
     wbuf b = {NULL, 0, 0, 0};
     put(&b, MAGIC, 8);
     /* version 1 unless a section of version 2 is needed, so that files
@@ -319,6 +333,7 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     odhs_driver *drv = NULL;
     odhs_stepper *st = NULL;
     double *tmpF = NULL;
+    if (errbuf && errlen) errbuf[0] = '\0'; /* "" on success, like the XYZ reader */
     if (sys_out) *sys_out = NULL;
     if (drv_out) *drv_out = NULL;
     if (st_out) *st_out = NULL;
@@ -364,10 +379,25 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     }
     for (size_t k = 0; k < dim; ++k)
         if (!(sys->L[k] >= 4.0 * rmax)) FAIL(ODHS_E_FORMAT, "checkpoint: box edge %zu too small", k);
+    /* the aspect-ratio rule of the system setters (lib/system.c, check_box):
+     * an XYZ file of a box outside it could not be read back (found by
+     * fuzz_checkpoint) */
+    if (!(sys->L[0] / sys->L[1] > 1e-100 && sys->L[0] / sys->L[1] < 1e100))
+        FAIL(ODHS_E_FORMAT, "checkpoint: box aspect ratio Lx/Ly = %g out of range [1e-100, 1e100]",
+             sys->L[0] / sys->L[1]);
     if (fabs(sys->gamma) > 0.5 * sys->L[0] / sys->L[1] * (1 + 1e-12))
         FAIL(ODHS_E_FORMAT, "checkpoint: strain outside its remapped range");
     for (size_t i = 0; i < nd; ++i)
         if (sys->x[i] < 0.0 || sys->x[i] >= sys->L[i % dim]) FAIL(ODHS_E_FORMAT, "checkpoint: position outside the box");
+    /* species labels as odhs_system_set_species accepts them (an empty or
+     * blank label made an XYZ file that could not be read back: found by
+     * fuzz_checkpoint); the bytes after the terminator are kept */
+    for (size_t i = 0; i < n; ++i) {
+        char lab[ODHS_SPECIES_MAX + 1];
+        memcpy(lab, sys->species[i], sizeof lab);
+        if (odhs_system_set_species(sys, i, lab))
+            FAIL(ODHS_E_FORMAT, "checkpoint: species label of particle %zu is not valid", i);
+    }
     sys->rmax = rmax;
     sys->has_r = sys->has_x = 1;
     /* driver */
@@ -431,10 +461,19 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     st->nb_stale = (int)stale;
     double sc[] = {st->dt, st->tol, st->h, st->lambda, st->contact_tol, st->time, st->strain, st->tau,
                    st->kappa, st->skin, st->rc};
-    if (!finite_all(sc, sizeof sc / sizeof sc[0]) || !finite_all(st->G, 9) || !finite_all(st->M, 9) ||
-        !finite_all(st->U, nd) || !finite_all(st->disp, nd) || !(st->dt > 0) || !(st->tol > 0 && st->tol < 1) ||
-        !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) || !(st->skin > 0) || st->contact_tol < 0)
-        FAIL(ODHS_E_FORMAT, "checkpoint: invalid stepper values");
+    static const char *const scn[] = {"dt", "tol", "h", "lambda", "contact_tol", "time", "strain", "tau",
+                                      "kappa", "skin", "rc"};
+    for (size_t k = 0; k < sizeof sc / sizeof sc[0]; ++k)
+        if (!isfinite(sc[k])) FAIL(ODHS_E_FORMAT, "checkpoint: stepper value %s is not finite", scn[k]);
+    if (!finite_all(st->G, 9) || !finite_all(st->M, 9) || !finite_all(st->U, nd) || !finite_all(st->disp, nd))
+        FAIL(ODHS_E_FORMAT, "checkpoint: non-finite number in the stepper section (%s)",
+             !finite_all(st->G, 9) ? "velocity gradient" : !finite_all(st->M, 9) ? "cell matrix"
+             : !finite_all(st->U, nd) ? "velocities" : "displacements");
+    if (!(st->dt > 0) || !(st->tol > 0 && st->tol < 1) || !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) ||
+        !(st->skin > 0) || st->contact_tol < 0)
+        FAIL(ODHS_E_FORMAT,
+             "checkpoint: invalid stepper values (dt %g, tol %g, h %g, tau %g, lambda %g, skin %g, contact_tol %g)",
+             st->dt, st->tol, st->h, st->tau, st->lambda, st->skin, st->contact_tol);
     if (npairs) {
         size_t *a = odhs__realloc(st->pi, (size_t)npairs * sizeof *a);
         if (a) st->pi = a;
@@ -569,6 +608,17 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     if (b.pos != b.len) FAIL(ODHS_E_FORMAT, "checkpoint: unexpected trailing data");
     odhs__net_geometry(st->net, sys);
     st->has_F = 0;
+    /* a contact is a pair at contact distance, up to the integrator's drift:
+     * far-apart "contacts" act as rigid bonds and the drift correction would
+     * move their particles into others (found by fuzz_checkpoint) */
+    for (size_t c = 0; c < st->net->nc; ++c) {
+        size_t i = st->net->ci[c], j = st->net->cj[c];
+        double sig = odhs__net_sigma(st->net, sys, c); /* rest length of bonds, a_i for walls */
+        if (!(fabs(st->net->gap[c]) <= CKPT_MAX_CONTACT_GAP * sig))
+            FAIL(ODHS_E_FORMAT, "checkpoint: contact (%zu,%zu) has a gap of %.3g contact distances", i, j,
+                 st->net->gap[c] / sig);
+    }
+    if (odhs__stepper_check_neighbours(st)) FAIL(ODHS_E_NOMEM, "checkpoint: out of memory");
     if (drv->F) {
         memcpy(st->F, drv->F, nd * sizeof *st->F);
         st->has_F = 1;
@@ -597,6 +647,7 @@ int odhs_checkpoint_read(const char *path, odhs_solver *solver, odhs_system **sy
     if (sys) *sys = NULL;
     if (drv) *drv = NULL;
     if (st) *st = NULL;
+    if (errbuf && errlen) errbuf[0] = '\0';
     if (!path) {
         if (errbuf && errlen) snprintf(errbuf, errlen, "checkpoint: path is NULL");
         return ODHS_E_NULL;

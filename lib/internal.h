@@ -260,6 +260,10 @@ void odhs__net_S(const odhs_network *net, const double *v, double *out);
 void odhs__net_ST(const odhs_network *net, const double *f, double *out);
 void odhs__net_N(const odhs_network *net, const double *x, double *out, double *work);
 
+/* restored stepper: mark the neighbour list stale unless it holds every pair
+ * closer than the unused skin (lib/stepper.c); ODHS_OK or ODHS_E_NOMEM */
+int odhs__stepper_check_neighbours(odhs_stepper *st);
+
 /* ---- solver handle ----------------------------------------------------------- */
 struct odhs_solver {
     const odhs_solver_type *type;
@@ -275,6 +279,11 @@ struct odhs_solver {
     double nsolves;
     double *work;    /* residual check */
     size_t work_cap;
+    /* fallback (odhs_solver_set_fallback): borrowed solver tried when a solve
+     * fails with ODHS_E_NOCONV or ODHS_E_SINGULAR */
+    struct odhs_solver *fallback;
+    double nfallbacks, nrescued; /* solves handed over / rescued by it */
+    int last_fallback;           /* the last solve was handed over */
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
@@ -393,8 +402,9 @@ struct odhs_stepper {
     size_t nrem, remcap;
     odhs_change *chg;
     size_t nchg, chgcap;
-    /* rollback snapshot */
-    double *xs;
+    /* rollback snapshot: xs holds 3 nd doubles, positions then Us, Fs */
+    double *xs, *Us, *Fs; /* Us, Fs: velocities and external forces */
+    int has_Fs;
     double Ls[3], gammas, times, strains, kappas;
     uint64_t nsteps_s;
     double Gs[9];

@@ -1,5 +1,6 @@
 /* libodhs - solver handle: wraps a backend table, checks every result. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "internal.h"
@@ -92,6 +93,18 @@ int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value)
         *value = s->nsolves;
         return ODHS_OK;
     }
+    if (!strcmp(key, "fallbacks")) {
+        *value = s->nfallbacks;
+        return ODHS_OK;
+    }
+    if (!strcmp(key, "fallback_rescued")) {
+        *value = s->nrescued;
+        return ODHS_OK;
+    }
+    if (!strcmp(key, "fallback_last")) {
+        *value = s->last_fallback;
+        return ODHS_OK;
+    }
     if (s->type->get_stat && s->type->get_stat(s->state, key, value) == ODHS_OK) return ODHS_OK;
     return solerr(s, ODHS_E_INVALID, "unknown statistic %s", key);
 }
@@ -141,7 +154,7 @@ static uint64_t net_checksum(const odhs_network *net)
 
 /* The one solve path: b given (N x = b), or g given (least squares on S^T,
  * b = S g). Sets up the backend when needed and checks the result. */
-static int solve_any(odhs_solver *s, const odhs_network *net, const double *b, const double *g, double *x,
+static int solve_one(odhs_solver *s, const odhs_network *net, const double *b, const double *g, double *x,
                      int reuse)
 {
     if (!s) return ODHS_E_NULL;
@@ -249,6 +262,40 @@ static int solve_any(odhs_solver *s, const odhs_network *net, const double *b, c
                       s->last_backward, s->check_tol, s->last_residual);
     }
     return ODHS_OK;
+}
+
+/* ---- fallback (odhs_solver_set_fallback) ------------------------------------ */
+int odhs_solver_set_fallback(odhs_solver *s, odhs_solver *fallback)
+{
+    if (!s) return ODHS_E_NULL;
+    for (const odhs_solver *f = fallback; f; f = f->fallback)
+        if (f == s) return solerr(s, ODHS_E_INVALID, "fallback would form a cycle back to %s", s->type->name);
+    s->fallback = fallback;
+    return ODHS_OK;
+}
+
+/* solve_one, then on a numerical failure (no convergence, singular or
+ * indefinite operator) the same problem with the fallback chain */
+static int solve_any(odhs_solver *s, const odhs_network *net, const double *b, const double *g, double *x,
+                     int reuse)
+{
+    if (s) s->last_fallback = 0;
+    int st = solve_one(s, net, b, g, x, reuse);
+    if (!s || !s->fallback || (st != ODHS_E_NOCONV && st != ODHS_E_SINGULAR)) return st;
+    odhs_solver *fb = s->fallback;
+    s->last_fallback = 1;
+    s->nfallbacks += 1.0;
+    char why[ODHS_ERRMSG_LEN];
+    snprintf(why, sizeof why, "%s", s->errmsg);
+    int fs = solve_any(fb, net, b, g, x, 0);
+    s->last_residual = fb->last_residual;
+    s->last_backward = fb->last_backward;
+    if (fs == ODHS_OK) {
+        s->nrescued += 1.0;
+        solerr(s, ODHS_OK, "%s; solved by the fallback %s", why, fb->type->name);
+        return ODHS_OK;
+    }
+    return solerr(s, fs, "%s; the fallback %s failed too: %s", why, fb->type->name, fb->errmsg);
 }
 
 int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse)

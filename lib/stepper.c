@@ -137,6 +137,9 @@ static int compute_forces(odhs_stepper *st)
     if (!drv->pressure_on) {
         set_gradient(st, drv->crate);
         st->kappa = drv->gdot != 0.0 ? drv->crate / drv->gdot : drv->crate;
+        /* a subnormal shear rate overflows the ratio (found by fuzzing the
+         * checkpoint reader): report c as without shear, never inf */
+        if (!isfinite(st->kappa)) st->kappa = drv->crate;
     }
     if (nc == 0) {
         if (drv->pressure_on) {
@@ -428,6 +431,61 @@ static double skin_used(const odhs_stepper *st)
     return 2.0 * sqrt(dmax) + frob(MI) * st->rc;
 }
 
+/* ---- neighbour list of a restored state ------------------------------------
+ * A checkpoint stores the neighbour list and its bookkeeping so that a
+ * continued run is bit-identical. A list that misses a pair closer than the
+ * unused skin (a corrupted file: found by fuzz_checkpoint, which then stepped
+ * particles deep into each other) is not trusted: the list is marked stale and
+ * rebuilt before the next step. */
+typedef struct {
+    const size_t *keys; /* sorted i * n + j of the stored pairs */
+    size_t nkeys, n;
+    int missing;
+} nbcheck_ctx;
+
+static int cmp_size(const void *a, const void *b)
+{
+    size_t x = *(const size_t *)a, y = *(const size_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static int nbcheck_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    (void)gap;
+    nbcheck_ctx *c = vctx;
+    size_t key = (i < j ? i : j) * c->n + (i < j ? j : i);
+    if (!bsearch(&key, c->keys, c->nkeys, sizeof key, cmp_size)) {
+        c->missing = 1;
+        return 1;
+    }
+    return 0;
+}
+
+int odhs__stepper_check_neighbours(odhs_stepper *st)
+{
+    if (st->nb_stale) return ODHS_OK;
+    odhs_system *s = st->sys;
+    double room = st->skin - skin_used(st);
+    /* rc as build_neighbours sets it; the list must hold every pair closer
+     * than the skin not used up yet */
+    if (!(st->rc == 2.0 * s->rmax + st->skin) || !isfinite(room)) {
+        st->nb_stale = 1;
+        return ODHS_OK;
+    }
+    if (room <= 0.0) return ODHS_OK; /* the next step rebuilds it anyway */
+    size_t *keys = odhs__malloc_array(st->npairs ? st->npairs : 1, sizeof *keys);
+    if (!keys) return ODHS_E_NOMEM;
+    for (size_t p = 0; p < st->npairs; ++p) keys[p] = st->pi[p] * st->n + st->pj[p];
+    qsort(keys, st->npairs, sizeof *keys, cmp_size);
+    nbcheck_ctx c = {keys, st->npairs, st->n, 0};
+    int r = odhs__pairs(st->dim, st->n, s->x, s->r, s->rmax, s->L, s->gamma, room * (1.0 - 1e-9), nbcheck_cb, &c);
+    odhs__free(keys);
+    if (r == ODHS_E_NOMEM) return ODHS_E_NOMEM;
+    if (r || c.missing) st->nb_stale = 1;
+    return ODHS_OK;
+}
+
 /* rate at which skin_used can grow while moving with velocity field (G, vel) */
 static double skin_rate(const odhs_stepper *st, const double *G, const double *vel)
 {
@@ -677,6 +735,9 @@ static int snapshot(odhs_stepper *st)
         memcpy(st->wsnap, net->walls, net->nwalls * sizeof *net->walls);
     }
     memcpy(st->xs, st->sys->x, st->nd * sizeof *st->xs);
+    memcpy(st->Us, st->U, st->nd * sizeof *st->Us);
+    memcpy(st->Fs, st->F, st->nd * sizeof *st->Fs);
+    st->has_Fs = st->has_F;
     memcpy(st->Ls, st->sys->L, sizeof st->Ls);
     st->gammas = st->sys->gamma;
     st->times = st->time;
@@ -718,8 +779,13 @@ static void rollback(odhs_stepper *st)
     odhs__net_geometry(net, st->sys);
     memcpy(st->G, st->Gs, sizeof st->G);
     st->kappa = st->kappas;
-    /* velocities from the restored forces */
-    if (eval_forces(st) == ODHS_OK) compute_velocities(st);
+    /* velocities and external forces as they were (recomputing them from the
+     * restored contact forces could call a failing force callback again, and
+     * gave non-finite velocities for a restored checkpoint whose forces
+     * overflow S^T f: found by fuzz_checkpoint) */
+    memcpy(st->U, st->Us, st->nd * sizeof *st->U);
+    memcpy(st->F, st->Fs, st->nd * sizeof *st->F);
+    st->has_F = st->has_Fs;
     st->nb_stale = 1; /* rebuild the neighbour list before the next step */
 }
 
@@ -748,7 +814,11 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->U = odhs__calloc(st->nd, sizeof(double));
     st->tmp = odhs__calloc(st->nd, sizeof(double));
     st->disp = odhs__calloc(st->nd, sizeof(double));
-    st->xs = odhs__calloc(st->nd, sizeof(double));
+    st->xs = odhs__calloc(3 * st->nd, sizeof(double));
+    if (st->xs) {
+        st->Us = st->xs + st->nd;
+        st->Fs = st->xs + 2 * st->nd;
+    }
     st->U0 = odhs__calloc(st->nd, sizeof(double));
     st->Ua = odhs__calloc(st->nd, sizeof(double));
     st->disps = odhs__calloc(st->nd, sizeof(double));
@@ -1015,6 +1085,12 @@ static int restart_step(odhs_stepper *st)
  * difference between the Euler and Heun non-affine displacements,
  * tau/2 max_i |U*_i - U0_i|, relative to the mean diameter. On return *Ga, st->Ua
  * hold the chord's gradient and velocities and *tau the accepted step. */
+/* Smallest adaptive step, relative to dt: without a floor an accepted step
+ * with an infinite error estimate (fac = 0) or repeated rejections from a
+ * tiny h set h to 0 and the integrator stalls forever (found by fuzzing the
+ * checkpoint reader). */
+#define HEUN_HMIN 1e-12
+
 static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
 {
     odhs_system *sys = st->sys;
@@ -1102,12 +1178,12 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
             }
             for (int a = 0; a < 9; ++a) Ga[a] = 0.5 * (G0[a] + Gs[a]);
             memcpy(st->U, st->U0, nd * sizeof *st->U);
-            if (!truncated) st->h = fmin(st->dt, st->h * fmin(2.0, fac));
+            if (!truncated) st->h = fmin(st->dt, fmax(st->h * fmin(2.0, fac), HEUN_HMIN * st->dt));
             *tau_out = tau;
             return ODHS_OK;
         }
         st->nrejected++;
-        st->h *= fmax(0.2, fac);
+        st->h = fmax(st->h * fmax(0.2, fac), HEUN_HMIN * st->dt);
     }
 }
 

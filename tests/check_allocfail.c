@@ -741,8 +741,10 @@ static void edit_final(af_fix *f, const af_scenario *sc) { check_network(f->net,
  *    after re-solving), 5 steps, drift correction; variants: 0 Euler + cg,
  *    1 Heun + dense, 2 Euler + cg at fixed pressure, 3 Heun + dense with
  *    self-propulsion (short persistence: most steps end at a switch, whose
- *    redraw a failed step must undo) and gravity with weights. The driver
- *    also carries (zero) external forces, so that their code paths run too. */
+ *    redraw a failed step must undo) and gravity with weights, 4 Euler + cg
+ *    capped at one iteration with a dense fallback (every solve goes through
+ *    it). The driver also carries (zero) external forces, so that their code
+ *    paths run too. */
 enum {
     SH_FORCES = 7,
     SH_RESET,
@@ -775,7 +777,24 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
         if (!s && v == 2) s = odhs_driver_set_pressure(f->drv, 0.05);
         return s;
     }
-    case 2: return odhs_solver_create_by_name(v == 1 || v == 3 ? "dense" : "cg", &f->sol);
+    case 2:
+        if (v == 4) { /* cg that never converges, rescued by a dense fallback;
+                       * all or nothing, like any other operation */
+            odhs_solver *cg = NULL, *dn = NULL;
+            int s = odhs_solver_create_by_name("cg", &cg);
+            if (!s) s = odhs_solver_create_by_name("dense", &dn);
+            if (!s) s = odhs_solver_set_param(cg, "maxiter", 1);
+            if (!s) s = odhs_solver_set_fallback(cg, dn);
+            if (s) {
+                odhs_solver_destroy(cg);
+                odhs_solver_destroy(dn);
+                return s;
+            }
+            f->sol = cg;
+            f->sol2 = dn;
+            return ODHS_OK;
+        }
+        return odhs_solver_create_by_name(v == 1 || v == 3 ? "dense" : "cg", &f->sol);
     case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
     case 4: return odhs_stepper_set_dt(f->st, 0.02);
     case 5:
@@ -1276,6 +1295,7 @@ static const af_scenario scenarios[] = {
     {"shear_heun_dense", SH_NOPS, 1, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_pressure", SH_NOPS, 2, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_propulsion", SH_NOPS, 3, shear_setup, NULL, shear_op, shear_capture, shear_final},
+    {"shear_cg_fallback", SH_NOPS, 4, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"checkpoint", 3, 0, ckpt_setup, NULL, ckpt_op, ckpt_capture, ckpt_final},

@@ -1337,6 +1337,15 @@ static int huge_rate_case(void)
       return odhs_solver_set_refinement(w->dense, -1);)                                                        \
     X(sol_refine_huge, odhs_solver_set_refinement, ODHS_E_INVALID, NOALT, H_DENSE, 0,                          \
       return odhs_solver_set_refinement(w->dense, INT_MAX);)                                                   \
+    X(sol_fallback_null, odhs_solver_set_fallback, ODHS_E_NULL, NOALT, H_NONE, 0,                              \
+      return odhs_solver_set_fallback(NULL, w->dense);)                                                        \
+    X(sol_fallback_self, odhs_solver_set_fallback, ODHS_E_INVALID, NOALT, H_CG, 0,                             \
+      return odhs_solver_set_fallback(w->cg, w->cg);)                                                          \
+    X(sol_fallback_cycle, odhs_solver_set_fallback, ODHS_E_INVALID, NOALT, H_DENSE, 0,                         \
+      odhs_solver *a_ = NULL; int rc = odhs_solver_create_by_name("cg", &a_); if (rc) return rc;                \
+      rc = odhs_solver_set_fallback(a_, w->dense); if (rc == ODHS_OK) rc = odhs_solver_set_fallback(w->dense, a_); \
+      if (rc < 0 && !odhs_solver_errmsg(w->dense)[0]) rc = post("no message");                                 \
+      odhs_solver_destroy(a_); return rc;)                                                                     \
     X(sol_solve_null, odhs_solver_solve, ODHS_E_NULL, NOALT, H_NONE, 0,                                        \
       double b[256] = {1}, x[256] = {0}; return odhs_solver_solve(NULL, odhs_stepper_network(w->run), b, x);)  \
     X(sol_solve_null_net, odhs_solver_solve, ODHS_E_NULL, NOALT, H_CG, 0,                                      \

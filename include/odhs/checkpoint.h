@@ -40,17 +40,24 @@ extern "C" {
 
 /**
  * Save the stepper's simulation to path (atomically). The stepper must be
- * ready (it has taken a step or been reset). Errors: ODHS_E_NULL,
- * ODHS_E_STATE, ODHS_E_NOMEM, ODHS_E_IO.
+ * ready (it has taken a step or been reset) and its contacts at contact
+ * distance up to 10% (far beyond any integration drift; the reader refuses
+ * more). Errors: ODHS_E_NULL, ODHS_E_STATE, ODHS_E_NOMEM, ODHS_E_IO.
  */
 ODHS_API int odhs_checkpoint_write(const odhs_stepper *st, const char *path);
 
 /**
  * Restore a checkpoint: creates a new system, driver and stepper (the stepper
  * borrows the other two and the given solver; destroy the stepper first).
- * On error all outputs are NULL and errbuf (may be NULL) holds a message.
+ * On error all outputs are NULL and errbuf (may be NULL) holds a message;
+ * on success errbuf holds "" (empty string).
  * Errors: ODHS_E_NULL, ODHS_E_IO, ODHS_E_FORMAT (bad magic, version,
- * checksum, sizes or values), ODHS_E_NOMEM.
+ * checksum, sizes or values: non-finite numbers, positions outside the box,
+ * box edges or aspect ratio that odhs_system_set_box refuses,
+ * species labels that odhs_system_set_species refuses, contacts farther than
+ * 10% from contact distance, duplicated contacts), ODHS_E_NOMEM. A stored
+ * neighbour list that misses a close pair is not trusted: it is rebuilt
+ * before the next step.
  */
 ODHS_API int odhs_checkpoint_read(const char *path, odhs_solver *solver, odhs_system **sys,
                                   odhs_driver **drv, odhs_stepper **st, char *errbuf, size_t errlen);

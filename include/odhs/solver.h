@@ -125,7 +125,9 @@ ODHS_API int odhs_solver_set_param(odhs_solver *s, const char *key, double value
  * Statistics: "iterations" (backend), "residual" (relative residual
  * |N x - b| / |b| of the last solve, computed by the library),
  * "backward_error" (|N x - b| / (|N| |x| + |b|) with |N| bounded by twice the
- * largest particle degree), "solves" (count).
+ * largest particle degree), "solves" (count), and with a fallback (see
+ * odhs_solver_set_fallback) "fallbacks", "fallback_rescued",
+ * "fallback_last".
  */
 ODHS_API int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value);
 /** Set the normwise backward error above which a solve is reported as failed
@@ -140,6 +142,27 @@ ODHS_API int odhs_solver_set_check_tolerance(odhs_solver *s, double tol);
  * solves accurate on ill-conditioned networks close to jamming.
  */
 ODHS_API int odhs_solver_set_refinement(odhs_solver *s, int steps);
+
+/**
+ * Opt-in recovery from numerical failure: when a solve of s fails with
+ * ODHS_E_NOCONV (an iterative backend did not converge, e.g. "cg" with a
+ * small "maxiter" on a stiff network close to jamming) or ODHS_E_SINGULAR
+ * (singular or indefinite operator, or a backward error above the check
+ * tolerance), the same problem is solved again with `fallback` (its own
+ * fallback in turn, if it has one). If the fallback succeeds the solve
+ * returns ODHS_OK with its result (the "residual" and "backward_error"
+ * statistics are the fallback's) and the error message of s records what
+ * happened; otherwise the fallback's error is returned. Other errors
+ * (NULL, non-finite input, out of memory) are returned as they are.
+ * Statistics of s: "fallbacks" (solves handed to the fallback),
+ * "fallback_rescued" (of those, solved by it), "fallback_last" (1 if the last
+ * solve was handed over, else 0). The fallback is borrowed: it must outlive
+ * s (or be removed first) and must not be used concurrently by another
+ * thread. NULL removes it (the default). ODHS_E_INVALID if the chain of
+ * fallbacks would lead back to s. Typical use: a "cg" solver with a "dense"
+ * (small systems) or "cholmod" fallback.
+ */
+ODHS_API int odhs_solver_set_fallback(odhs_solver *s, odhs_solver *fallback);
 
 /**
  * Solve N x = b on the network's current geometry. The backend's setup runs
