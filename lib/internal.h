@@ -73,6 +73,7 @@ struct odhs_system {
     char (*species)[ODHS_SPECIES_MAX + 1];
     int has_x, has_r;
     double rmax;    /* largest radius (0 if unset) */
+    double overlap_accept; /* relative overlap accepted by the setters (0: 1e-10) */
     char errmsg[ODHS_ERRMSG_LEN];
 };
 

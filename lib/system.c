@@ -86,6 +86,7 @@ typedef struct {
     size_t wi, wj;
     double wgap;
     double tol_abs; /* absolute tolerance, < 0: use relative acceptance */
+    double rel;     /* relative acceptance */
 } overlap_ctx;
 
 static int overlap_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
@@ -93,7 +94,7 @@ static int overlap_cb(size_t i, size_t j, const double *rij, double gap, void *v
     (void)rij;
     overlap_ctx *c = vctx;
     double dsum = c->r[i] + c->r[j];
-    double lim = c->tol_abs >= 0.0 ? -c->tol_abs : -ODHS_OVERLAP_ACCEPT * dsum;
+    double lim = c->tol_abs >= 0.0 ? -c->tol_abs : -c->rel * dsum;
     if (gap < lim && gap / dsum < c->worst) {
         c->worst = gap / dsum;
         c->wi = i;
@@ -157,7 +158,7 @@ static int check_positions(const odhs_system *sys, const double *L, const double
 static int check_overlaps(const odhs_system *sys, const double *L, double gamma, const double *r,
                           double rmax, const double *x, double tol_abs)
 {
-    overlap_ctx c = {r, 0.0, 0, 0, 0.0, tol_abs};
+    overlap_ctx c = {r, 0.0, 0, 0, 0.0, tol_abs, sys->overlap_accept > 0.0 ? sys->overlap_accept : ODHS_OVERLAP_ACCEPT};
     int st = odhs__pairs(sys->dim, sys->n, x, r, rmax, L, gamma, 0.0, overlap_cb, &c);
     if (st == ODHS_E_NOMEM) return odhs__syserr(sys, st, "out of memory in overlap check");
     if (c.worst < 0.0)

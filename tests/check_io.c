@@ -866,6 +866,27 @@ START_TEST(test_write_replaces_existing)
 }
 END_TEST
 
+/* A state written between two drift corrections reads back: contact gaps
+ * drift to small negative values (overlaps up to ~1e-4 of the contact
+ * distance with the paper's Euler steps); real overlaps are still refused,
+ * and the setters keep their 1e-10 acceptance. */
+START_TEST(test_read_drifted_contacts)
+{
+    const char *ok = "2\n" HDR3 "\nA 1 1 1 0.5\nA 1.99999 1 1 0.5\n";   /* overlap 1e-5 */
+    const char *bad = "2\n" HDR3 "\nA 1 1 1 0.5\nA 1.9998 1 1 0.5\n";   /* overlap 2e-4 */
+    odhs_system *sys = NULL;
+    char err[256];
+    ck_assert_int_eq(odhs_xyz_parse(ok, strlen(ok), &sys, err, sizeof err), ODHS_OK);
+    double x[6];
+    ck_assert_int_eq(odhs_system_get_positions(sys, x), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_positions(sys, x), ODHS_E_OVERLAP); /* the setters: 1e-10 */
+    odhs_system_destroy(sys);
+    sys = NULL;
+    ck_assert_int_eq(odhs_xyz_parse(bad, strlen(bad), &sys, err, sizeof err), ODHS_E_OVERLAP);
+    ck_assert_ptr_null(sys);
+}
+END_TEST
+
 Suite *make_io_suite(void)
 {
     Suite *s = suite_create("io");
@@ -884,6 +905,7 @@ Suite *make_io_suite(void)
     tcase_add_test(tc, test_read_handwritten_2d);
     tcase_add_test(tc, test_read_variants);
     tcase_add_test(tc, test_read_extra_columns);
+    tcase_add_test(tc, test_read_drifted_contacts);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("malformed");

@@ -16,7 +16,10 @@
  * ignored; keys may appear in any order; dim defaults to 3, or 2 when pbc's
  * third flag is F; strain defaults to bx/Ly. Orthogonal-cell lattices only
  * (apart from the x-y shear). Malformed input gives ODHS_E_FORMAT with a message
- * naming the line, and never a half-filled system.
+ * naming the line, and never a half-filled system. Overlaps up to 1e-4 of the
+ * contact distance are accepted on reading (the drift of contact gaps between
+ * two drift corrections, so that any state the stepper reaches reads back);
+ * the system setters accept 1e-10.
  */
 #ifndef ODHS_IO_H
 #define ODHS_IO_H
