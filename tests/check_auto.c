@@ -246,6 +246,10 @@ START_TEST(test_choice)
     CK_OK(odhs_solver_set_param(a, "suitesparse", 0.0));
 #else
     ck_assert_double_eq(au_stat(a, "suitesparse"), 0.0);
+    /* a build with SUITESPARSE=0: the SuiteSparse backends are not there */
+    odhs_solver *none = NULL;
+    ck_assert_int_eq(odhs_solver_create_by_name("cholmod-pcg", &none), ODHS_E_NOTINSTALLED);
+    ck_assert_int_eq(odhs_solver_create_by_name("spqr", &none), ODHS_E_NOTINSTALLED);
     ck_assert_int_eq(odhs_solver_set_param(a, "suitesparse", 1.0), ODHS_E_NOTINSTALLED);
 #endif
     CK_OK(odhs_solver_solve(a, big.net, b, x));
@@ -461,6 +465,57 @@ static au_case zigzag(size_t K, double theta, tu_rng *rng)
     return c;
 }
 
+/* normwise least-squares backward error |S (S^T x - g)| / (|S|^2 |x| + |S| |g|)
+ * (|S| <= 2 for discs of degree <= 2) */
+static double ls_eta(const au_case *c, const double *x, const double *g)
+{
+    double *rp = xcalloc(c->nd, sizeof *rp), *sr = xcalloc(c->nc, sizeof *sr), gn = 0.0, srn = 0.0, xn = 0.0;
+    CK_OK(odhs_network_apply_ST(c->net, x, rp));
+    for (size_t q = 0; q < c->nd; ++q) {
+        rp[q] -= g[q];
+        gn += g[q] * g[q];
+    }
+    for (size_t k = 0; k < c->nc; ++k) xn += x[k] * x[k];
+    CK_OK(odhs_network_apply_S(c->net, rp, sr));
+    for (size_t k = 0; k < c->nc; ++k) srn += sr[k] * sr[k];
+    free(rp);
+    free(sr);
+    return sqrt(srn) / (4.0 * sqrt(xn) + 2.0 * sqrt(gn));
+}
+
+/* without SuiteSparse (any build, "suitesparse" = 0): dense rejects the
+ * chain, the SVD least-squares route answers (full rank at lsq_rcond) */
+START_TEST(test_fallback_ill_conditioned_nosuitesparse)
+{
+    tu_rng rng;
+    tu_rng_seed(&rng, 42);
+    au_case c = zigzag(40, 1e-8, &rng);
+    double *g = xcalloc(c.nd, sizeof *g), *x = xcalloc(c.nc, sizeof *x), *xr = xcalloc(c.nc, sizeof *xr);
+    au_vec(c.nd, g, &rng);
+    odhs_solver *a = au_solver("auto");
+    CK_OK(odhs_solver_set_param(a, "suitesparse", 0.0));
+    CK_OK(odhs_solver_solve_ls(a, c.net, g, x));
+    const char *why;
+    ck_assert_str_eq(au_backend(a, &why), "lsq-svd");
+    ck_assert_msg(strstr(why, "dense failed") && strstr(why, "-> lsq-svd"), "why = \"%s\"", why);
+    ck_assert_double_eq(au_stat(a, "rank"), (double)c.nc);
+    double eta = ls_eta(&c, x, g);
+    ck_assert_msg(eta <= 1e-13, "least-squares backward error %.3g", eta);
+    size_t rank;
+    au_pinv_ref(&c, g, xr, &rank);
+    ck_assert_uint_eq(rank, c.nc);
+    /* two SVD routes to the same least-squares solution */
+    double e = au_reldiff(c.nc, x, xr);
+    ck_assert_msg(e <= 1e-9, "differs from dgelsd by %.3g", e);
+    fprintf(stderr, "[auto] zigzag without SuiteSparse: %s (vs dgelsd %.1e, eta %.1e)\n", why, e, eta);
+    odhs_solver_destroy(a);
+    free(g);
+    free(x);
+    free(xr);
+    au_free(&c);
+}
+END_TEST
+
 START_TEST(test_fallback_ill_conditioned)
 {
 #ifdef ODHS_HAVE_SUITESPARSE
@@ -487,17 +542,7 @@ START_TEST(test_fallback_ill_conditioned)
     ck_assert_double_eq(au_stat(a, "rank"), (double)c.nc); /* spqr's statistic */
     ck_assert(au_reldiff(c.nc, x, xq) <= 1e-12);
     /* least squares: the residual S^T x - g is orthogonal to range(S^T) */
-    /* (normwise, |S| <= 2 for discs of degree <= 2)                          */
-    double *rp = xcalloc(c.nd, sizeof *rp), *sr = xcalloc(c.nc, sizeof *sr), gn = 0.0, srn = 0.0, xn = 0.0;
-    CK_OK(odhs_network_apply_ST(c.net, x, rp));
-    for (size_t q = 0; q < c.nd; ++q) {
-        rp[q] -= g[q];
-        gn += g[q] * g[q];
-    }
-    for (size_t k = 0; k < c.nc; ++k) xn += x[k] * x[k];
-    CK_OK(odhs_network_apply_S(c.net, rp, sr));
-    for (size_t k = 0; k < c.nc; ++k) srn += sr[k] * sr[k];
-    double eta = sqrt(srn) / (4.0 * sqrt(xn) + 2.0 * sqrt(gn));
+    double eta = ls_eta(&c, x, g);
     ck_assert_msg(eta <= 1e-13, "|S (S^T x - g)| / (|S|^2 |x| + |S| |g|) = %.3g", eta);
     /* sticky: the next solve goes to spqr directly, without a new failure */
     CK_OK(odhs_solver_solve_ls(a, c.net, g, x));
@@ -518,8 +563,6 @@ START_TEST(test_fallback_ill_conditioned)
     free(g);
     free(x);
     free(xq);
-    free(rp);
-    free(sr);
     au_free(&c);
 #endif
 }
@@ -646,6 +689,7 @@ Suite *make_auto_suite(void)
     tcase_add_test(tc, test_agree_3d);
     tcase_add_test(tc, test_stepper_shear);
     tcase_add_test(tc, test_fallback_ill_conditioned);
+    tcase_add_test(tc, test_fallback_ill_conditioned_nosuitesparse);
     tcase_add_test(tc, test_hyperstatic_hex);
     tcase_add_test(tc, test_hyperstatic_square_lattice);
     tcase_add_test(tc, test_hyperstatic_random);
