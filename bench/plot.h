@@ -29,6 +29,7 @@ typedef struct {
     int color, dash, marker, lines;
     size_t n, cap;
     double *x, *y;
+    char (*lab)[24]; /* optional point labels ("" = none) */
 } pl_series;
 
 typedef struct {
@@ -46,9 +47,9 @@ static const char *const pl_colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0
 static inline void pl_init(pl_plot *p, const char *title, const char *xl, const char *yl, int logx, int logy)
 {
     memset(p, 0, sizeof *p);
-    snprintf(p->title, sizeof p->title, "%s", title);
-    snprintf(p->xlabel, sizeof p->xlabel, "%s", xl);
-    snprintf(p->ylabel, sizeof p->ylabel, "%s", yl);
+    snprintf(p->title, sizeof p->title, "%.159s", title);
+    snprintf(p->xlabel, sizeof p->xlabel, "%.95s", xl);
+    snprintf(p->ylabel, sizeof p->ylabel, "%.95s", yl);
     p->logx = logx;
     p->logy = logy;
 }
@@ -59,7 +60,7 @@ static inline int pl_series_add(pl_plot *p, const char *name, int color, int das
     if (p->ns >= PL_MAXS) return PL_MAXS - 1;
     pl_series *s = &p->s[p->ns];
     memset(s, 0, sizeof *s);
-    snprintf(s->name, sizeof s->name, "%s", name);
+    snprintf(s->name, sizeof s->name, "%.95s", name);
     s->color = color;
     s->dash = dash;
     s->marker = marker;
@@ -80,16 +81,29 @@ static inline void pl_point(pl_plot *p, int k, double x, double y)
         double *ny = realloc(s->y, c * sizeof *ny);
         if (!ny) return;
         s->y = ny;
+        char(*nl)[24] = realloc(s->lab, c * sizeof *nl);
+        if (!nl) return;
+        s->lab = nl;
         s->cap = c;
     }
     s->x[s->n] = x;
     s->y[s->n] = y;
+    s->lab[s->n][0] = '\0';
     s->n++;
+}
+
+/* a point with a small text label next to it */
+static inline void pl_point_label(pl_plot *p, int k, double x, double y, const char *label)
+{
+    if (k < 0 || k >= p->ns) return;
+    size_t before = p->s[k].n;
+    pl_point(p, k, x, y);
+    if (p->s[k].n > before) snprintf(p->s[k].lab[before], sizeof p->s[k].lab[0], "%.23s", label);
 }
 
 static inline void pl_note(pl_plot *p, const char *text)
 {
-    if (p->nnotes < 3) snprintf(p->note[p->nnotes++], sizeof p->note[0], "%s", text);
+    if (p->nnotes < 3) snprintf(p->note[p->nnotes++], sizeof p->note[0], "%.199s", text);
 }
 
 static inline void pl_free(pl_plot *p)
@@ -97,6 +111,7 @@ static inline void pl_free(pl_plot *p)
     for (int k = 0; k < p->ns; ++k) {
         free(p->s[k].x);
         free(p->s[k].y);
+        free(p->s[k].lab);
     }
     p->ns = 0;
 }
@@ -125,9 +140,15 @@ static inline void pl_range(const pl_plot *p, int axis, double *lo, double *hi)
         }
     if (!isfinite(a)) a = 0, b = 1;
     if (lg) {
-        a = floor(a + 1e-9);
-        b = ceil(b - 1e-9);
-        if (b <= a) b = a + 1;
+        /* at least one decade, padded by 4% so that markers on the edge show */
+        if (b - a < 1.0) {
+            double m = 0.5 * (a + b);
+            a = m - 0.5;
+            b = m + 0.5;
+        }
+        double pad = 0.04 * (b - a);
+        a -= pad;
+        b += pad;
     } else {
         double pad = (b - a) * 0.05;
         if (pad == 0) pad = fabs(a) > 0 ? 0.1 * fabs(a) : 1.0;
@@ -199,11 +220,15 @@ static inline int pl_write_svg(const pl_plot *p, const char *path)
             double raw = (b - a) / 6.0, mag = pow(10.0, floor(log10(raw))), q = raw / mag;
             step = (q < 1.5 ? 1 : q < 3.5 ? 2 : q < 7.5 ? 5 : 10) * mag;
         }
-        for (double v = ceil(a / step - 1e-9) * step; v <= b + 1e-9 * step; v += step) {
+        double vstart = lg ? floor(a) : ceil(a / step - 1e-9) * step;
+        for (double v = vstart; v <= b + 1e-9 * step; v += step) {
             double pos = axis ? T + ph - (v - a) / (b - a) * ph : L + (v - a) / (b - a) * pw;
+            int major = v >= a - 1e-9;
             char lab[32];
             pl_fmt(lab, sizeof lab, v, lg);
-            if (axis) {
+            if (!major) {
+                /* below the axis start: only its minor ticks (below) */
+            } else if (axis) {
                 fprintf(f, "<line x1='%.1f' y1='%.1f' x2='%.1f' y2='%.1f' stroke='#ddd'/>\n", L, pos, L + pw, pos);
                 fprintf(f, "<line x1='%.1f' y1='%.1f' x2='%.1f' y2='%.1f' stroke='black'/>\n", L - 5, pos, L, pos);
                 fprintf(f, "<text x='%.1f' y='%.1f' text-anchor='end'>%s</text>\n", L - 8, pos + 4, lab);
@@ -218,6 +243,7 @@ static inline int pl_write_svg(const pl_plot *p, const char *path)
                 for (int m = 2; m <= 9; ++m) {
                     double u = v + log10((double)m);
                     if (u > b) break;
+                    if (u < a) continue;
                     double q = axis ? T + ph - (u - a) / (b - a) * ph : L + (u - a) / (b - a) * pw;
                     if (axis)
                         fprintf(f, "<line x1='%.1f' y1='%.1f' x2='%.1f' y2='%.1f' stroke='black'/>\n", L - 3, q, L, q);
@@ -248,6 +274,19 @@ static inline int pl_write_svg(const pl_plot *p, const char *path)
         for (size_t i = 0; i < s->n; ++i) pl_marker(f, s->marker, PL_X(s->x[i]), PL_Y(s->y[i]), c);
     }
     fprintf(f, "</svg>\n");
+    /* point labels (not clipped; to the left of points in the right tenth) */
+    for (int k = 0; k < p->ns; ++k) {
+        const pl_series *s = &p->s[k];
+        for (size_t i = 0; i < s->n; ++i) {
+            if (!s->lab[i][0]) continue;
+            double px = PL_X(s->x[i]), py = PL_Y(s->y[i]);
+            int left = px > L + 0.9 * pw;
+            fprintf(f, "<text x='%.1f' y='%.1f' font-size='9' fill='%s'%s>", left ? px - 6 : px + 6, py - 5,
+                    pl_colors[s->color % 10], left ? " text-anchor='end'" : "");
+            pl_esc(f, s->lab[i]);
+            fprintf(f, "</text>\n");
+        }
+    }
     /* legend */
     double ly = T + 10;
     for (int k = 0; k < p->ns; ++k) {
