@@ -5,9 +5,12 @@
  * random placement at phi = 0.45 (2D) / 0.30 (3D), compression at rate 1
  * (cholmod-pcg, dt 1e-3, drift correction every step) until the stepper
  * certifies a jammed packing (ODHS_JAMMED, include/odhs/jamming.h): phi_J.
- * On the way a snapshot (positions and the stepper's contact list) is kept
- * every 0.0005 in phi; the states at phi_J - delta (delta = 0.005, 0.002,
- * 0.001: the nearest snapshot below) are the test networks.
+ * A snapshot (positions and the stepper's contact list) is kept after every
+ * step; the states just below phi_J - delta are the test networks: delta =
+ * 0.005 and 0.002 from this run; delta = 1e-3 ... 1e-6 from a second
+ * approach started at phi_J - 0.003 with dt = 1e-6 (smaller steps get much
+ * closer to jamming; that run jams at its own, slightly different phi_J,
+ * against which its deltas are measured).
  *
  * On each network every backend solves N f = b once from a fresh handle
  * (setup included in the time), b the simple-shear right-hand side
@@ -33,7 +36,8 @@
 #include "odhs.h"
 #include "plot.h"
 
-#define NSNAP 40
+#define NSNAP 400
+#define NFINE 4000
 
 typedef struct {
     odhs_system *sys;
@@ -108,7 +112,7 @@ int main(int argc, char **argv)
         size_t n;
         uint64_t seed;
     } sc[] = {{2, 64, 1}, {2, 128, 1}, {2, 256, 1}, {3, 64, 1}};
-    const double deltas[] = {0.005, 0.002, 0.001};
+    const double deltas[] = {0.005, 0.002, 1e-3, 1e-4, 1e-5, 1e-6};
     pl_plot p;
     pl_init(&p, "Relative residual of N f = b below jamming (2D N = 256)", "phi_J - phi",
             "relative residual |N f - b| / |b|", 1, 1);
@@ -127,34 +131,64 @@ int main(int argc, char **argv)
         odhs_driver_set_compression_rate(drv, 1.0);
         odhs_stepper_create(sys, drv, sol, &st);
         odhs_stepper_set_correction_interval(st, 1);
-        snap ring[NSNAP];
-        memset(ring, 0, sizeof ring);
-        size_t nsnap = 0;
-        double phi, t0 = cpu_now();
-        odhs_system_packing_fraction(sys, &phi);
-        double target = sc[q].dim == 2 ? 0.78 : 0.58;
-        int rc = odhs_stepper_run_until_packing_fraction(st, target);
+        /* first approach (dt 1e-3): a snapshot after every step */
+        snap *ring = calloc(NSNAP, sizeof *ring), *fine = calloc(NFINE, sizeof *fine);
+        size_t nsnap = 0, nfine = 0;
+        double t0 = cpu_now();
+        int rc = odhs_stepper_run_until_packing_fraction(st, sc[q].dim == 2 ? 0.76 : 0.56);
         while (rc == ODHS_OK) {
-            snap_take(&ring[nsnap % NSNAP], sys, odhs_stepper_network(st));
-            nsnap++;
-            target += 0.0005;
-            rc = odhs_stepper_run_until_packing_fraction(st, target);
+            rc = odhs_stepper_step(st, NULL);
+            if (rc == ODHS_OK) snap_take(&ring[nsnap++ % NSNAP], sys, odhs_stepper_network(st));
         }
         double phiJ = NAN;
         odhs_system_packing_fraction(sys, &phiJ);
+        /* second approach from phi_J - 0.003 with dt 1e-6: states much
+         * closer to jamming; its own phi_J (the path differs slightly) */
+        snap *from = NULL;
+        for (size_t k = 0; k < NSNAP && k < nsnap; ++k)
+            if (ring[k].sys && ring[k].phi <= phiJ - 0.003 && (!from || ring[k].phi > from->phi)) from = &ring[k];
+        double phiJ2 = NAN;
+        int rc2 = -1;
+        if (rc == ODHS_JAMMED && from) {
+            odhs_system *s2;
+            odhs_solver *so2;
+            odhs_driver *dr2;
+            odhs_stepper *st2;
+            odhs_system_clone(from->sys, &s2);
+            if (odhs_solver_create_by_name("cholmod-pcg", &so2)) odhs_solver_create_by_name("dense", &so2);
+            odhs_driver_create(&dr2);
+            odhs_driver_set_compression_rate(dr2, 1.0);
+            odhs_stepper_create(s2, dr2, so2, &st2);
+            odhs_stepper_set_correction_interval(st2, 1);
+            odhs_stepper_set_dt(st2, 1e-6);
+            rc2 = ODHS_OK;
+            for (long k = 0; k < 200000 && rc2 == ODHS_OK; ++k) {
+                rc2 = odhs_stepper_step(st2, NULL);
+                if (rc2 == ODHS_OK) snap_take(&fine[nfine++ % NFINE], s2, odhs_stepper_network(st2));
+            }
+            odhs_system_packing_fraction(s2, &phiJ2);
+            odhs_stepper_destroy(st2);
+            odhs_driver_destroy(dr2);
+            odhs_solver_destroy(so2);
+            odhs_system_destroy(s2);
+        }
         double tj = cpu_now() - t0;
         if (rc != ODHS_JAMMED) {
             printf("%3d %5zu  compression stopped without jamming: %s\n", sc[q].dim, sc[q].n, odhs_stepper_errmsg(st));
         } else {
-            printf("# %dD N=%zu: jammed at phi_J = %.6f after %.1f s CPU\n", sc[q].dim, sc[q].n, phiJ, tj);
+            printf("# %dD N=%zu: jammed at phi_J = %.6f (dt 1e-3); from phi_J - 0.003 with dt 1e-6: %s at %.9f; %.1f s "
+                   "CPU\n", sc[q].dim, sc[q].n, phiJ, rc2 == ODHS_JAMMED ? "jammed" : "not jammed", phiJ2, tj);
         }
         for (size_t d = 0; d < sizeof deltas / sizeof *deltas && rc == ODHS_JAMMED; ++d) {
-            /* the snapshot just below phi_J - delta */
-            snap *best = NULL;
-            for (size_t k = 0; k < NSNAP && k < nsnap; ++k)
-                if (ring[k].sys && ring[k].phi <= phiJ - deltas[d] + 1e-12 &&
-                    (!best || ring[k].phi > best->phi))
-                    best = &ring[k];
+            /* the snapshot just below phi_J - delta: delta >= 0.002 from the
+             * first approach, smaller ones from the second */
+            int use_fine = deltas[d] < 0.0015;
+            if (use_fine && rc2 != ODHS_JAMMED) continue;
+            snap *rg = use_fine ? fine : ring, *best = NULL;
+            size_t cnt = use_fine ? nfine : nsnap, cap = use_fine ? NFINE : NSNAP;
+            double pj = use_fine ? phiJ2 : phiJ;
+            for (size_t k = 0; k < cap && k < cnt; ++k)
+                if (rg[k].sys && rg[k].phi <= pj - deltas[d] && (!best || rg[k].phi > best->phi)) best = &rg[k];
             if (!best) continue;
             odhs_network *net;
             odhs_network_create(best->sys, &net);
@@ -197,12 +231,12 @@ int main(int argc, char **argv)
                     snprintf(note + len, sizeof note - len, "%sbackend %s%s%.80s", len ? "; " : "", bn,
                              why[0] ? ": " : "", why);
                 }
-                printf("%3d %5zu %9.6f %8.4f %6zu %-12s %9.3f %9.1e %9.1e %9.1e %9.1e  %s\n", sc[q].dim, sc[q].n, phiJ,
-                       phiJ - best->phi, nc, names[k], ms, res, bw, e, k == 1 ? rcond : NAN, note);
+                printf("%3d %5zu %9.6f %8.1e %6zu %-12s %9.3f %9.1e %9.1e %9.1e %9.1e  %s\n", sc[q].dim, sc[q].n, pj,
+                       pj - best->phi, nc, names[k], ms, res, bw, e, k == 1 ? rcond : NAN, note);
                 if (csv)
-                    fprintf(csv, "%d,%zu,%.6f,%.5f,%zu,%s,%.4f,%.3e,%.3e,%.3e,%.3e,%d\n", sc[q].dim, sc[q].n, phiJ,
-                            phiJ - best->phi, nc, names[k], ms, res, bw, e, k == 1 ? rcond : NAN, sr);
-                if (sc[q].dim == 2 && sc[q].n == 256) pl_point(&p, ser[k], phiJ - best->phi, res);
+                    fprintf(csv, "%d,%zu,%.9f,%.3e,%zu,%s,%.4f,%.3e,%.3e,%.3e,%.3e,%d\n", sc[q].dim, sc[q].n, pj,
+                            pj - best->phi, nc, names[k], ms, res, bw, e, k == 1 ? rcond : NAN, sr);
+                if (sc[q].dim == 2 && sc[q].n == 256) pl_point(&p, ser[k], pj - best->phi, res);
                 odhs_solver_destroy(s);
             }
             fflush(stdout);
@@ -212,6 +246,9 @@ int main(int argc, char **argv)
             odhs_network_destroy(net);
         }
         for (size_t k = 0; k < NSNAP; ++k) snap_free(&ring[k]);
+        for (size_t k = 0; k < NFINE; ++k) snap_free(&fine[k]);
+        free(ring);
+        free(fine);
         odhs_stepper_destroy(st);
         odhs_driver_destroy(drv);
         odhs_solver_destroy(sol);
