@@ -114,7 +114,7 @@ int main(int argc, char **argv)
     } sc[] = {{2, 64, 1}, {2, 128, 1}, {2, 256, 1}, {3, 64, 1}};
     const double deltas[] = {0.005, 0.002, 1e-3, 1e-4, 1e-5, 1e-6};
     pl_plot p;
-    pl_init(&p, "Relative residual of N f = b below jamming (2D N = 256)", "phi_J - phi",
+    pl_init(&p, "Relative residual of N f = b below jamming (2D N = 128)", "phi_J - phi",
             "relative residual |N f - b| / |b|", 1, 1);
     int ser[NB];
     for (int k = 0; k < NB; ++k) ser[k] = pl_series_add(&p, names[k], k, 0, 1 + k % 5);
@@ -167,6 +167,9 @@ int main(int argc, char **argv)
                 if (rc2 == ODHS_OK) snap_take(&fine[nfine++ % NFINE], s2, odhs_stepper_network(st2));
             }
             odhs_system_packing_fraction(s2, &phiJ2);
+            if (rc2 != ODHS_JAMMED)
+                printf("# %dD N=%zu: second approach stopped (%d): %s\n", sc[q].dim, sc[q].n, rc2,
+                       odhs_stepper_errmsg(st2));
             odhs_stepper_destroy(st2);
             odhs_driver_destroy(dr2);
             odhs_solver_destroy(so2);
@@ -236,7 +239,7 @@ int main(int argc, char **argv)
                 if (csv)
                     fprintf(csv, "%d,%zu,%.9f,%.3e,%zu,%s,%.4f,%.3e,%.3e,%.3e,%.3e,%d\n", sc[q].dim, sc[q].n, pj,
                             pj - best->phi, nc, names[k], ms, res, bw, e, k == 1 ? rcond : NAN, sr);
-                if (sc[q].dim == 2 && sc[q].n == 256) pl_point(&p, ser[k], pj - best->phi, res);
+                if (sc[q].dim == 2 && sc[q].n == 128) pl_point(&p, ser[k], pj - best->phi, res);
                 odhs_solver_destroy(s);
             }
             fflush(stdout);
