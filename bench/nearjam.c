@@ -36,7 +36,7 @@
 #include "odhs.h"
 #include "plot.h"
 
-#define NSNAP 400
+#define NSNAP 4000
 #define NFINE 4000
 
 typedef struct {
