@@ -25,6 +25,8 @@
  *
  * usage: scaling [NLIST] [K] [SVG] [CSV] [PAPER_NMAX]
  *        defaults 100,316,1000,3162,10000  10  scaling.svg  (none)  10000
+ *        scaling --plot SVG CSV...   fit and plot rows of earlier runs' CSVs
+ *        (e.g. sizes measured in separate processes)
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -231,8 +233,109 @@ static void measure(size_t n, double K, size_t paper_nmax, result *res)
     odhs_system_destroy(start);
 }
 
+/* least-squares exponents and the log-log plot of cost per unit strain */
+static void plot_and_fit(const result *all, size_t nn, double K, double load, const char *cpu, const char *svg)
+{
+    /* fits and plot */
+    pl_plot p;
+    pl_init(&p, "Cost per unit strain, 2D, phi = 0.80", "N", "CPU seconds per unit strain", 1, 1);
+    for (int s = 0; s < S_COUNT; ++s) {
+        double x[16], y[16];
+        size_t m = 0;
+        for (size_t q = 0; q < nn; ++q)
+            if (!all[q].rc[s]) {
+                x[m] = (double)all[q].n;
+                y[m] = all[q].cpu[s] / all[q].window;
+                m++;
+            }
+        double a = 0.0, e = pl_fit_loglog(x, y, m, &a);
+        char lab[96];
+        snprintf(lab, sizeof lab, "%s", s ? "paper: euler 1e-5, cg" : "default: heun 1e-7, auto");
+        int k = pl_series_add(&p, lab, s ? 1 : 0, 0, s ? 2 : 1);
+        for (size_t i = 0; i < m; ++i) pl_point(&p, k, x[i], y[i]);
+        if (m >= 2) {
+            printf("# %s: cost per unit strain ~ N^%.2f (least-squares fit of log cost on log N, %zu sizes)\n",
+                   sname[s], e, m);
+            snprintf(lab, sizeof lab, "fit N^%.2f", e);
+            int f = pl_series_add(&p, lab, s ? 1 : 0, 1, 0);
+            pl_point(&p, f, x[0], exp(a) * pow(x[0], e));
+            pl_point(&p, f, x[m - 1], exp(a) * pow(x[m - 1], e));
+        }
+    }
+    /* the N^2 target line through the default's first point */
+    if (!all[0].rc[S_DEFAULT]) {
+        int t = pl_series_add(&p, "N^2 (target bound)", 7, 2, 0);
+        double y0 = all[0].cpu[S_DEFAULT] / all[0].window;
+        pl_point(&p, t, (double)all[0].n, y0);
+        pl_point(&p, t, (double)all[nn - 1].n, y0 * pow((double)all[nn - 1].n / all[0].n, 2.0));
+    }
+    char note[400];
+    snprintf(note, sizeof note, "%.120s, %ld CPUs, shared (load %.1f); window %g/N after warm-up 2W", cpu,
+             sysconf(_SC_NPROCESSORS_ONLN), load, K);
+    pl_note(&p, note);
+    if (pl_write_svg(&p, svg)) fprintf(stderr, "scaling: cannot write %s\n", svg);
+    else printf("# plot: %s\n", svg);
+    pl_free(&p);
+}
+
+/* --plot: rows of earlier runs' CSV files (N,Nc,phi,window,setting,...,cpu_s,...) */
+static int replot(int argc, char **argv)
+{
+    if (argc < 4) {
+        fprintf(stderr, "usage: scaling --plot SVG CSV...\n");
+        return 2;
+    }
+    result all[16];
+    size_t nn = 0;
+    memset(all, 0, sizeof all);
+    for (int a = 3; a < argc; ++a) {
+        FILE *f = fopen(argv[a], "r");
+        if (!f) {
+            fprintf(stderr, "scaling: cannot open %s\n", argv[a]);
+            return 1;
+        }
+        char line[512];
+        while (fgets(line, sizeof line, f)) {
+            size_t n, nc;
+            double phi, w, wall, cpu_s;
+            char set[32];
+            unsigned long long steps, events;
+            if (sscanf(line, "%zu,%zu,%lf,%lf,%31[^,],%llu,%llu,%lf,%lf", &n, &nc, &phi, &w, set, &steps, &events,
+                       &wall, &cpu_s) != 9)
+                continue;
+            size_t q = 0;
+            while (q < nn && all[q].n != n) ++q;
+            if (q == nn) {
+                if (nn == 16) continue;
+                nn++;
+                all[q].n = n;
+                all[q].rc[0] = all[q].rc[1] = 1;
+            }
+            int s = strcmp(set, "paper") ? S_DEFAULT : S_PAPER;
+            all[q].window = w;
+            all[q].cpu[s] = cpu_s;
+            all[q].rc[s] = 0;
+        }
+        fclose(f);
+    }
+    /* ascending N */
+    for (size_t i = 1; i < nn; ++i)
+        for (size_t j = i; j > 0 && all[j - 1].n > all[j].n; --j) {
+            result t = all[j];
+            all[j] = all[j - 1];
+            all[j - 1] = t;
+        }
+    char cpu[256];
+    cpu_model(cpu, sizeof cpu);
+    double la[3] = {0, 0, 0};
+    getloadavg(la, 3);
+    plot_and_fit(all, nn, all[0].window * (double)all[0].n, la[0], cpu, argv[2]);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "--plot")) return replot(argc, argv);
     size_t ns[16], nn = 0;
     {
         char buf[256];
@@ -307,47 +410,8 @@ int main(int argc, char **argv)
         }
         fflush(stdout);
     }
-    /* fits and plot */
-    pl_plot p;
-    pl_init(&p, "Cost per unit strain, 2D, phi = 0.80", "N", "CPU seconds per unit strain", 1, 1);
-    for (int s = 0; s < S_COUNT; ++s) {
-        double x[16], y[16];
-        size_t m = 0;
-        for (size_t q = 0; q < nn; ++q)
-            if (!all[q].rc[s]) {
-                x[m] = (double)all[q].n;
-                y[m] = all[q].cpu[s] / all[q].window;
-                m++;
-            }
-        double a = 0.0, e = pl_fit_loglog(x, y, m, &a);
-        char lab[96];
-        snprintf(lab, sizeof lab, "%s", s ? "paper: euler 1e-5, cg" : "default: heun 1e-7, auto");
-        int k = pl_series_add(&p, lab, s ? 1 : 0, 0, s ? 2 : 1);
-        for (size_t i = 0; i < m; ++i) pl_point(&p, k, x[i], y[i]);
-        if (m >= 2) {
-            printf("# %s: cost per unit strain ~ N^%.2f (least-squares fit of log cost on log N, %zu sizes)\n",
-                   sname[s], e, m);
-            snprintf(lab, sizeof lab, "fit N^%.2f", e);
-            int f = pl_series_add(&p, lab, s ? 1 : 0, 1, 0);
-            pl_point(&p, f, x[0], exp(a) * pow(x[0], e));
-            pl_point(&p, f, x[m - 1], exp(a) * pow(x[m - 1], e));
-        }
-    }
-    /* the N^2 target line through the default's first point */
-    if (!all[0].rc[S_DEFAULT]) {
-        int t = pl_series_add(&p, "N^2 (target bound)", 7, 2, 0);
-        double y0 = all[0].cpu[S_DEFAULT] / all[0].window;
-        pl_point(&p, t, (double)all[0].n, y0);
-        pl_point(&p, t, (double)all[nn - 1].n, y0 * pow((double)all[nn - 1].n / all[0].n, 2.0));
-    }
-    char note[400];
-    snprintf(note, sizeof note, "%.120s, %ld CPUs, shared (load %.1f); window %g/N after warm-up 2W", cpu,
-             sysconf(_SC_NPROCESSORS_ONLN), la[0], K);
-    pl_note(&p, note);
+    plot_and_fit(all, nn, K, la[0], cpu, svg);
     for (size_t q = 0; q < nn; ++q) printf("# peak RSS N=%zu: %.1f MiB\n", all[q].n, rss[q]);
-    if (pl_write_svg(&p, svg)) fprintf(stderr, "scaling: cannot write %s\n", svg);
-    else printf("# plot: %s\n", svg);
-    pl_free(&p);
     if (csv) fclose(csv);
     return 0;
 }
