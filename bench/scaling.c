@@ -270,8 +270,12 @@ static void plot_and_fit(const result *all, size_t nn, double K, double load, co
         pl_point(&p, t, (double)all[nn - 1].n, y0 * pow((double)all[nn - 1].n / all[0].n, 2.0));
     }
     char note[400];
-    snprintf(note, sizeof note, "%.120s, %ld CPUs, shared (load %.1f); window %g/N after warm-up 2W", cpu,
-             sysconf(_SC_NPROCESSORS_ONLN), load, K);
+    if (isnan(load))
+        snprintf(note, sizeof note, "%.120s, %ld CPUs, shared; window %g/N after warm-up 2W; rows from earlier runs",
+                 cpu, sysconf(_SC_NPROCESSORS_ONLN), K);
+    else
+        snprintf(note, sizeof note, "%.120s, %ld CPUs, shared (load %.1f); window %g/N after warm-up 2W", cpu,
+                 sysconf(_SC_NPROCESSORS_ONLN), load, K);
     pl_note(&p, note);
     if (pl_write_svg(&p, svg)) fprintf(stderr, "scaling: cannot write %s\n", svg);
     else printf("# plot: %s\n", svg);
@@ -327,9 +331,7 @@ static int replot(int argc, char **argv)
         }
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
-    double la[3] = {0, 0, 0};
-    getloadavg(la, 3);
-    plot_and_fit(all, nn, all[0].window * (double)all[0].n, la[0], cpu, argv[2]);
+    plot_and_fit(all, nn, all[0].window * (double)all[0].n, NAN, cpu, argv[2]);
     return 0;
 }
 
