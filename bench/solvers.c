@@ -43,7 +43,13 @@
  * "ratio" is ms/solve over the cg row of the same scene and mode class
  * (cold for the static modes, stepper for stepper).
  *
- * usage: solvers [CSV-PATH]      (the table also goes to CSV-PATH if given)
+ * Times are CPU seconds of the process (the machine may be shared).
+ * Plots: PREFIX_2d.svg and PREFIX_3d.svg, ms per solve against N in stepper
+ * mode (every backend and packing fraction) and fresh mode (cholmod, spqr,
+ * dense; cold cg).
+ *
+ * usage: solvers [CSV-PATH] [PREFIX]  (the table also goes to CSV-PATH if
+ *        given and not ""; PREFIX default "solvers")
  * environment: ODHS_BENCH_BUDGET  seconds (default 540): rows that would start
  *              after it are skipped (and say so);
  *              ODHS_BENCH_CACHE   directory for compressed scenes (default
@@ -62,6 +68,7 @@
 #include <time.h>
 
 #include "odhs.h"
+#include "plot.h"
 
 #ifdef ODHS_HAVE_SUITESPARSE
 #if defined(__GNUC__)
@@ -75,6 +82,7 @@
 /* declared here until solver.h carries them */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
+ODHS_API extern const odhs_solver_type odhs_solver_type_spqr;
 #endif
 
 /* ---- utilities ------------------------------------------------------------ */
@@ -83,6 +91,14 @@ static double now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* CPU time of the process: the measurements (the machine may be shared) */
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
@@ -145,8 +161,13 @@ static void print_header(void)
     if (csv) fprintf(csv, "N,dim,phi,Nc,solver,mode,ms_per_solve,residual,iterations,reps,ratio_to_cg,note\n");
 }
 
+#define MAXROWS 512
+static row rows[MAXROWS];
+static size_t nrows;
+
 static void print_row(const row *r)
 {
+    if (nrows < MAXROWS) rows[nrows++] = *r;
     char ms[32], res[32], it[32], ratio[32];
     if (isnan(r->ms)) snprintf(ms, sizeof ms, "-");
     else snprintf(ms, sizeof ms, "%.3f", r->ms);
@@ -172,7 +193,9 @@ static const odhs_solver_type *type_by_name(const char *name)
 {
     if (!strcmp(name, "cg")) return &odhs_solver_type_cg;
     if (!strcmp(name, "dense")) return &odhs_solver_type_dense;
+    if (!strcmp(name, "auto")) return &odhs_solver_type_auto;
 #ifdef ODHS_HAVE_SUITESPARSE
+    if (!strcmp(name, "spqr")) return &odhs_solver_type_spqr;
     if (!strcmp(name, "cholmod")) return &odhs_solver_type_cholmod;
     if (!strcmp(name, "cholmod-pcg")) return &odhs_solver_type_cholmod_pcg;
 #endif
@@ -225,18 +248,18 @@ static int tw_setup(void *state, const odhs_network *net)
 {
     tw_state *s = state;
     if (!s->inner->setup) return ODHS_OK;
-    double t0 = now();
+    double t0 = cpu_now();
     int st = s->inner->setup(s->st, net);
-    s->t += now() - t0;
+    s->t += cpu_now() - t0;
     return st;
 }
 
 static int tw_solve(void *state, const odhs_network *net, const double *b, double *x)
 {
     tw_state *s = state;
-    double t0 = now();
+    double t0 = cpu_now();
     int st = s->inner->solve(s->st, net, b, x);
-    s->t += now() - t0;
+    s->t += cpu_now() - t0;
     s->ncsum += (double)odhs_network_count(net);
     s->ncalls += 1.0;
     /* residual outside the timed region */
@@ -584,14 +607,14 @@ static void measure_static(const scene *s, const char *solver, const char *mode,
             if (rc) break;
         }
         memset(x, 0, nc * sizeof *x);
-        double t0 = now();
+        double t0 = cpu_now();
         if (fresh) {
             rc = odhs_solver_create(type, &sol);
             if (!rc) rc = odhs_solver_solve(sol, net, b, x);
         } else {
             rc = odhs_solver_solve(sol, net, b, x);
         }
-        tsum += now() - t0;
+        tsum += cpu_now() - t0;
         double v = 0.0;
         odhs_solver_get_stat(sol, "residual", &v);
         res = fmax(res, v);
@@ -675,7 +698,7 @@ int main(int argc, char **argv)
     t_start = now();
     const char *bs = getenv("ODHS_BENCH_BUDGET");
     if (bs && atof(bs) > 0) budget = atof(bs);
-    if (argc > 1) {
+    if (argc > 1 && argv[1][0]) {
         csv = fopen(argv[1], "w");
         if (!csv) {
             fprintf(stderr, "cannot open %s\n", argv[1]);
@@ -712,9 +735,9 @@ int main(int argc, char **argv)
         {3, 1000, 0.58}, {3, 3000, 0.55}, {3, 3000, 0.58},
     };
     const char *static_modes[][2] = {
-        {"cg", "cold"}, {"cholmod", "fresh"}, {"cholmod", "refactor"}, {"dense", "fresh"},
+        {"cg", "cold"}, {"cholmod", "fresh"}, {"cholmod", "refactor"}, {"spqr", "fresh"}, {"dense", "fresh"},
     };
-    const char *stepper_solvers[] = {"cg", "cholmod", "cholmod-pcg", "dense"};
+    const char *stepper_solvers[] = {"cg", "cholmod", "cholmod-pcg", "auto", "dense"};
     for (size_t q = 0; q < sizeof sc / sizeof *sc; ++q) {
         row r;
         memset(&r, 0, sizeof r);
@@ -781,6 +804,43 @@ int main(int argc, char **argv)
         fclose(lf);
     }
     printf("# total wall time %.1f s; load average at the end: %.2f %.2f %.2f\n", now() - t_start, la[0], la[1], la[2]);
+    /* plots: ms per solve against N, one file per dimension */
+    const char *prefix = argc > 2 ? argv[2] : "solvers";
+    const char *pnames[] = {"cg", "cholmod", "cholmod-pcg", "auto", "dense", "spqr"};
+    for (int dim = 2; dim <= 3; ++dim) {
+        pl_plot p;
+        char title[128], path[512];
+        snprintf(title, sizeof title, "Time per force solve, %dD (solid: stepper mode, dashed: fresh/cold)", dim);
+        pl_init(&p, title, "N", "CPU ms per solve", 1, 1);
+        double phis[2] = {dim == 2 ? 0.70 : 0.55, dim == 2 ? 0.80 : 0.58};
+        for (int ph = 1; ph >= 0; --ph)
+            for (int m = 0; m < 2; ++m)
+                for (size_t k = 0; k < sizeof pnames / sizeof *pnames; ++k) {
+                    int any = 0, ser = -1;
+                    for (size_t q = 0; q < nrows; ++q) {
+                        const row *r = &rows[q];
+                        if (r->dim != dim || fabs(r->phi - phis[ph]) > 1e-9 || !r->solver ||
+                            strcmp(r->solver, pnames[k]) || isnan(r->ms))
+                            continue;
+                        int stepper = !strcmp(r->mode, "stepper");
+                        if (stepper != (m == 0) || !strcmp(r->mode, "refactor")) continue;
+                        if (!any) {
+                            char lab[64];
+                            snprintf(lab, sizeof lab, "%s %s, phi %.2f", pnames[k], m == 0 ? "stepper" : r->mode,
+                                     phis[ph]);
+                            ser = pl_series_add(&p, lab, (int)k, m == 0 ? (ph ? 0 : 2) : 1, ph ? 1 : 2);
+                            any = 1;
+                        }
+                        pl_point(&p, ser, (double)r->n, r->ms);
+                    }
+                }
+        char note[300];
+        snprintf(note, sizeof note, "CPU time per solve; shared machine; N = 10000 (2D) and 3000 (3D) are tilings");
+        pl_note(&p, note);
+        snprintf(path, sizeof path, "%s_%dd.svg", prefix, dim);
+        if (p.ns && pl_write_svg(&p, path) == 0) printf("# plot: %s\n", path);
+        pl_free(&p);
+    }
     if (csv) fclose(csv);
     return 0;
 }

@@ -13,8 +13,15 @@
  * The paper's settings always use CG (the paper's solver); the adaptive
  * settings use SOLVER.
  *
- * usage: trade [N] [GAMMA] [SOLVER] [CSV]   (defaults 1000, 0.01, cg)
+ * Times: wall seconds and CPU seconds of the process (the machine may be
+ * shared: the ratios use CPU time). The summary compares, for each paper
+ * setting, the fastest other setting that is at least as accurate in all
+ * three errors (rms position, worst gap, stress series).
+ *
+ * usage: trade [N] [GAMMA] [SOLVER] [CSV] [SVG]   (defaults 1000, 0.01, cg,
+ *        no CSV, trade.svg: rms position error against CPU time)
  */
+#define _DEFAULT_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +30,7 @@
 #include <time.h>
 
 #include "odhs.h"
+#include "plot.h"
 
 #define NSAMP 20
 
@@ -30,6 +38,13 @@ static double now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
@@ -59,7 +74,7 @@ typedef struct {
 } setting;
 
 typedef struct {
-    double seconds, rms, maxdx, gap, stress_err;
+    double seconds, cpu, rms, maxdx, gap, stress_err;
     uint64_t steps, events, rejected;
     double stress[NSAMP + 1];
     double *x;
@@ -84,7 +99,7 @@ static int run(const odhs_system *start, const char *solver, const setting *s, d
     odhs_stepper_set_correction_interval(st, s->corr);
     r->gap = 0.0;
     r->rc = 0;
-    double t0 = now();
+    double t0 = now(), c0 = cpu_now();
     r->rc = odhs_stepper_reset(st);
     for (int k = 0; k <= NSAMP && !r->rc; ++k) {
         if (k) r->rc = odhs_stepper_run_until_strain(st, gamma * k / NSAMP);
@@ -94,6 +109,7 @@ static int run(const odhs_system *start, const char *solver, const setting *s, d
         odhs_stepper_shear_stress(st, &r->stress[k]);
     }
     r->seconds = now() - t0;
+    r->cpu = cpu_now() - c0;
     uint64_t nc, no;
     odhs_stepper_counts(st, &r->steps, &nc, &no);
     odhs_stepper_adaptive_stats(st, &r->rejected, NULL);
@@ -113,7 +129,8 @@ int main(int argc, char **argv)
     size_t n = argc > 1 ? (size_t)atol(argv[1]) : 1000;
     double gamma = argc > 2 ? atof(argv[2]) : 0.01;
     const char *solver = argc > 3 ? argv[3] : "cg";
-    FILE *csv = argc > 4 ? fopen(argv[4], "w") : NULL;
+    FILE *csv = argc > 4 && argv[4][0] ? fopen(argv[4], "w") : NULL;
+    const char *svg = argc > 5 ? argv[5] : "trade.svg";
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
 
@@ -136,7 +153,10 @@ int main(int argc, char **argv)
     odhs_driver_destroy(drv);
     odhs_solver_destroy(cg);
 
-    printf("# machine: %s; libodhs %s\n", cpu, odhs_version_string());
+    double la[3] = {0, 0, 0};
+    getloadavg(la, 3);
+    printf("# machine: %s; libodhs %s; load average at the start %.2f %.2f %.2f (shared machine: ratios use CPU "
+           "time)\n", cpu, odhs_version_string(), la[0], la[1], la[2]);
     printf("# N = %zu 2D bidisperse, phi = 0.80, shear to strain %g; paper settings: cg, others: %s\n", n,
            gamma, solver);
     setting ref = {"reference heun tol 1e-11, corr 1", ODHS_INTEGRATOR_HEUN, 1e-3, 1e-11, 1};
@@ -164,12 +184,13 @@ int main(int argc, char **argv)
     }
     double smean = 0.0;
     for (int k = 0; k <= NSAMP; ++k) smean += fabs(R.stress[k]) / (NSAMP + 1);
-    printf("# reference: %.2f s, %llu steps, %llu events, worst gap %.2e\n", R.seconds,
+    printf("# reference: %.2f s wall, %.2f s CPU, %llu steps, %llu events, worst gap %.2e\n", R.seconds, R.cpu,
            (unsigned long long)R.steps, (unsigned long long)R.events, R.gap);
-    printf("%-34s %9s %9s %8s %8s %10s %10s %10s %10s %9s\n", "setting", "seconds", "steps", "events", "rejected",
-           "rms_dx", "max_dx", "worst_gap", "stress_err", "vs_e1e-5");
-    if (csv) fprintf(csv, "setting,seconds,steps,events,rejected,rms_dx,max_dx,worst_gap,stress_err\n");
+    printf("%-34s %9s %9s %9s %8s %8s %10s %10s %10s %10s %9s\n", "setting", "wall_s", "cpu_s", "steps", "events",
+           "rejected", "rms_dx", "max_dx", "worst_gap", "stress_err", "vs_e1e-5");
+    if (csv) fprintf(csv, "setting,wall_s,cpu_s,steps,events,rejected,rms_dx,max_dx,worst_gap,stress_err\n");
     double t_paper5 = 0.0;
+    result keep[32];
     double L[3];
     odhs_system_get_box(sys, L);
     double gref;
@@ -181,7 +202,7 @@ int main(int argc, char **argv)
         result r;
         memset(&r, 0, sizeof r);
         int rc = run(sys, solver, &set[k], gamma, &r);
-        if (k == 1) t_paper5 = r.seconds;
+        if (k == 1) t_paper5 = r.cpu;
         double s2 = 0.0, mx = 0.0, serr = 0.0;
         if (!rc) {
             /* the final box is the same (fixed volume, same strain): compare by
@@ -199,16 +220,67 @@ int main(int argc, char **argv)
             }
             for (int q = 0; q <= NSAMP; ++q) serr = fmax(serr, fabs(r.stress[q] - R.stress[q]) / smean);
         }
-        printf("%-34s %9.3f %9llu %8llu %8llu %10.2e %10.2e %10.2e %10.2e %9.2f%s\n", set[k].label, r.seconds,
-               (unsigned long long)r.steps, (unsigned long long)r.events, (unsigned long long)r.rejected, sqrt(s2), mx,
-               r.gap, serr, t_paper5 > 0 ? t_paper5 / r.seconds : 0.0, rc ? "  FAILED" : "");
+        printf("%-34s %9.3f %9.3f %9llu %8llu %8llu %10.2e %10.2e %10.2e %10.2e %9.2f%s\n", set[k].label,
+               r.seconds, r.cpu, (unsigned long long)r.steps, (unsigned long long)r.events,
+               (unsigned long long)r.rejected, sqrt(s2), mx, r.gap, serr, t_paper5 > 0 ? t_paper5 / r.cpu : 0.0,
+               rc ? "  FAILED" : "");
         if (csv)
-            fprintf(csv, "%s,%.6f,%llu,%llu,%llu,%.6e,%.6e,%.6e,%.6e\n", set[k].label, r.seconds,
+            fprintf(csv, "%s,%.6f,%.6f,%llu,%llu,%llu,%.6e,%.6e,%.6e,%.6e\n", set[k].label, r.seconds, r.cpu,
                     (unsigned long long)r.steps, (unsigned long long)r.events, (unsigned long long)r.rejected,
                     sqrt(s2), mx, r.gap, serr);
         fflush(stdout);
         free(r.x);
+        r.x = NULL;
+        r.rms = sqrt(s2);
+        r.maxdx = mx;
+        r.stress_err = serr;
+        keep[k] = r;
     }
+    /* summary: for each paper setting the fastest setting at least as accurate */
+    for (size_t p = 0; p < nset; ++p) {
+        if (strncmp(set[p].label, "paper", 5) || keep[p].rc) continue;
+        size_t best = nset;
+        for (size_t k = 0; k < nset; ++k) {
+            if (k == p || !strncmp(set[k].label, "paper", 5) || keep[k].rc) continue;
+            if (keep[k].rms <= keep[p].rms && keep[k].gap <= keep[p].gap && keep[k].stress_err <= keep[p].stress_err &&
+                (best == nset || keep[k].cpu < keep[best].cpu))
+                best = k;
+        }
+        if (best == nset) printf("# %s: no other setting is at least as accurate in all three errors\n", set[p].label);
+        else
+            printf("# %s (%.2f s CPU): fastest at least as accurate: %s, %.2f s CPU, speed ratio %.1f\n",
+                   set[p].label, keep[p].cpu, set[best].label, keep[best].cpu, keep[p].cpu / keep[best].cpu);
+    }
+    /* plot: rms position error against CPU time */
+    pl_plot pp;
+    char title[160];
+    snprintf(title, sizeof title, "Speed/accuracy trade, N = %zu, 2D, phi = 0.80, strain %g", n, gamma);
+    pl_init(&pp, title, "CPU seconds", "rms position error (mean diameters)", 1, 1);
+    int fam[4];
+    fam[0] = pl_series_add(&pp, "paper: euler, cg, corr 10", 1, 0, 2);
+    fam[1] = pl_series_add(&pp, "euler dt 1e-5, other corr", 3, 1, 3);
+    char hl[64];
+    snprintf(hl, sizeof hl, "heun (adaptive), %s, corr 10", solver);
+    fam[2] = pl_series_add(&pp, hl, 0, 0, 1);
+    fam[3] = pl_series_add(&pp, "heun tol 1e-8, corr 100", 2, 1, 4);
+    pp.s[fam[1]].lines = 0;
+    pp.s[fam[3]].lines = 0;
+    for (size_t k = 0; k < nset; ++k) {
+        if (keep[k].rc) continue;
+        const char *l = set[k].label;
+        int f = !strncmp(l, "paper", 5) ? 0 : !strncmp(l, "euler", 5) ? 1 : strstr(l, "corr") ? 3 : 2;
+        char lab[24];
+        if (f == 0) snprintf(lab, sizeof lab, "dt %.0e", set[k].dt);
+        else if (f == 1) snprintf(lab, sizeof lab, "corr %u", set[k].corr);
+        else snprintf(lab, sizeof lab, "tol %.0e", set[k].tol);
+        pl_point_label(&pp, fam[f], keep[k].cpu, keep[k].rms, lab);
+    }
+    char note[300];
+    snprintf(note, sizeof note, "%.120s; shared machine (load %.1f); reference heun tol 1e-11, corr 1", cpu, la[0]);
+    pl_note(&pp, note);
+    if (pl_write_svg(&pp, svg)) fprintf(stderr, "trade: cannot write %s\n", svg);
+    else printf("# plot: %s\n", svg);
+    pl_free(&pp);
     if (csv) fclose(csv);
     free(R.x);
     free(rad);

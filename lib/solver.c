@@ -45,12 +45,13 @@ int odhs_solver_create_by_name(const char *name, odhs_solver **out)
     if (!name) return ODHS_E_NULL;
     if (!strcmp(name, "cg")) return odhs_solver_create(&odhs_solver_type_cg, out);
     if (!strcmp(name, "dense")) return odhs_solver_create(&odhs_solver_type_dense, out);
+    if (!strcmp(name, "auto")) return odhs_solver_create(&odhs_solver_type_auto, out); /* lib/solvers/auto.c */
 #ifdef ODHS_HAVE_SUITESPARSE
     if (!strcmp(name, "spqr")) return odhs_solver_create(&odhs_solver_type_spqr, out);
     if (!strcmp(name, "cholmod")) return odhs_solver_create(&odhs_solver_type_cholmod, out);
     if (!strcmp(name, "cholmod-pcg")) return odhs_solver_create(&odhs_solver_type_cholmod_pcg, out);
 #endif
-    if (!strcmp(name, "cholmod") || !strcmp(name, "spqr") || !strcmp(name, "auto") || !strcmp(name, "cholmod-pcg"))
+    if (!strcmp(name, "cholmod") || !strcmp(name, "spqr") || !strcmp(name, "cholmod-pcg"))
         return ODHS_E_NOTINSTALLED;
     return ODHS_E_INVALID;
 }

@@ -1292,6 +1292,15 @@ static int huge_rate_case(void)
       const char *m = odhs_solver_errmsg(NULL); return m && !m[0] ? ODHS_OK : post("errmsg(NULL)");)           \
     X(sol_name_null, odhs_solver_name, ODHS_OK, NOALT, H_NONE, 0,                                              \
       const char *m = odhs_solver_name(NULL); return m ? ODHS_OK : post("name(NULL) is NULL");)                \
+    X(sol_backend_null, odhs_solver_backend_name, ODHS_E_NULL, NOALT, H_NONE, 0,                               \
+      const char *nm = NULL; return odhs_solver_backend_name(NULL, &nm, NULL);)                                 \
+    X(sol_backend_null_name, odhs_solver_backend_name, ODHS_E_NULL, NOALT, H_CG, 0,                            \
+      const char *why = NULL; return odhs_solver_backend_name(w->cg, NULL, &why);)                              \
+    X(sol_backend_auto_param, odhs_solver_set_param, ODHS_E_INVALID, NOALT, H_NONE, 0,                         \
+      odhs_solver *s = NULL; int rc = odhs_solver_create_by_name("auto", &s); if (rc) return post("create %d", rc); \
+      rc = odhs_solver_set_param(s, "prefer", 2.0); const char *nm = NULL;                                     \
+      if (odhs_solver_backend_name(s, &nm, NULL) || strcmp(nm, "auto")) rc = post("backend name changed");     \
+      odhs_solver_destroy(s); return rc;)                                                                      \
     X(sol_param_null, odhs_solver_set_param, ODHS_E_NULL, NOALT, H_NONE, 0,                                    \
       return odhs_solver_set_param(NULL, "tol", 1e-10);)                                                       \
     X(sol_param_null_key, odhs_solver_set_param, ODHS_E_NULL, NOALT, H_CG, 0,                                  \

@@ -104,13 +104,43 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_spqr;
  *  networks. Statistics: "rcond", "lapack_info". O(Nc^3) per setup. */
 ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
 
+/** Automatic choice with fallbacks ("auto"; in every build). The primary
+ *  backend follows the number of contacts Nc: dense for Nc <= "dense_max"
+ *  (-1, the default, means 16 with SuiteSparse and 400 without), else
+ *  cholmod-pcg (or cholmod with "prefer" = 1) with SuiteSparse, cg without.
+ *  When a backend reports ODHS_E_SINGULAR (non-positive or tiny pivot,
+ *  condition estimate below its min_rcond, backward error above the check
+ *  tolerance), ODHS_E_NOCONV or ODHS_E_NOMEM, the next one is tried: spqr
+ *  with SuiteSparse (least squares on S^T, rank-revealing); without it dense
+ *  (after cg, for Nc <= "dense_fallback_max", default 4000); last the
+ *  minimum-norm least-squares forces x = (S^T)^+ g (= N^+ b for b = S g),
+ *  the answer on a rank-deficient (hyperstatic) network, where the
+ *  least-squares forces are not unique: backend "lsq-svd" (truncated SVD,
+ *  Nc <= "lsq_dense_max", default 600; rank from SuiteSparseQR when it ran,
+ *  else singular values above "lsq_rcond" (default 1e-9) times the largest,
+ *  of S^T for odhs_solver_solve_ls and of N, with the threshold squared but
+ *  at least 1e-13, for odhs_solver_solve) or "lsq-cg" (CG from zero). The
+ *  backend that answered after a fallback is tried first for the next
+ *  "retry_after" solves (default 20). Inner backends run behind their own
+ *  wrappers (result check, iterative refinement); their check tolerance is
+ *  the parameter "check_tol" (default 1e-6). "suitesparse" = 0 makes a
+ *  SuiteSparse build choose as a build without it (1 in a build without
+ *  gives ODHS_E_NOTINSTALLED). Statistics: "backend" and "primary" (codes
+ *  0 cg, 1 dense, 2 cholmod, 3 cholmod-pcg, 4 spqr, 5 lsq-svd, 6 lsq-cg; -1
+ *  before the first solve), "fallbacks" (failed attempts followed by another
+ *  backend), "fallback_solves" (solves not answered by the primary),
+ *  "rank_deficient" (solves answered by lsq-*), "last_failure" (status of
+ *  the last failed attempt), "suitesparse", and those of the backend that
+ *  answered last ("rank" after lsq-*). See odhs_solver_backend_name. */
+ODHS_API extern const odhs_solver_type odhs_solver_type_auto;
+
 typedef struct odhs_solver odhs_solver; /* struct tag declared in network.h */
 
 /** Create a solver handle for a backend type (user or built-in). The table
  *  must outlive the handle. ODHS_E_INVALID for a malformed table. */
 ODHS_API int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out);
-/** Create a built-in solver by name: "cg", "dense", and with SuiteSparse
- *  "cholmod", "cholmod-pcg", "spqr". Names of backends not built into this
+/** Create a built-in solver by name: "cg", "dense", "auto", and with
+ *  SuiteSparse "cholmod", "cholmod-pcg", "spqr". Names of backends not built into this
  *  library give ODHS_E_NOTINSTALLED; unknown names ODHS_E_INVALID. */
 ODHS_API int odhs_solver_create_by_name(const char *name, odhs_solver **out);
 /** Destroy; NULL is a no-op. */
@@ -119,6 +149,17 @@ ODHS_API void odhs_solver_destroy(odhs_solver *s);
 ODHS_API const char *odhs_solver_errmsg(const odhs_solver *s);
 /** Backend name. */
 ODHS_API const char *odhs_solver_name(const odhs_solver *s);
+/**
+ * The backend that produced the last solution: for an "auto" handle the one
+ * it chose or fell back to ("cg", "dense", "cholmod", "cholmod-pcg", "spqr",
+ * "lsq-svd", "lsq-cg"; "auto" before its first solve), for any other handle
+ * its own name. *why (why may be NULL) receives a description of the
+ * fallbacks of the last solve ("cholmod-pcg failed (...) -> spqr"), "" when
+ * there was none; after a failed solve it lists every attempt. Both strings
+ * live until the next solve or the destruction of the handle.
+ * ODHS_E_NULL for a NULL handle or name.
+ */
+ODHS_API int odhs_solver_backend_name(const odhs_solver *s, const char **name, const char **why);
 /** Set a backend parameter (see each backend). */
 ODHS_API int odhs_solver_set_param(odhs_solver *s, const char *key, double value);
 /**
