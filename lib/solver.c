@@ -94,15 +94,15 @@ int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value)
         *value = s->nsolves;
         return ODHS_OK;
     }
-    if (!strcmp(key, "fallbacks")) {
+    if (!strcmp(key, "chain_fallbacks")) {
         *value = s->nfallbacks;
         return ODHS_OK;
     }
-    if (!strcmp(key, "fallback_rescued")) {
+    if (!strcmp(key, "chain_rescued")) {
         *value = s->nrescued;
         return ODHS_OK;
     }
-    if (!strcmp(key, "fallback_last")) {
+    if (!strcmp(key, "chain_last")) {
         *value = s->last_fallback;
         return ODHS_OK;
     }

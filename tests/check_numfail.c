@@ -14,7 +14,7 @@
  *   - hyperstatic_crystal: a monodisperse triangular crystal patch in contact
  *     everywhere (z = 6 > 2d: N = S S^T singular): dense reports
  *     ODHS_E_SINGULAR, cg with the dense fallback reports the fallback's
- *     ODHS_E_SINGULAR with both messages, and "fallback_rescued" stays 0.
+ *     ODHS_E_SINGULAR with both messages, and "chain_rescued" stays 0.
  *   - duplicated_contact: a network with the same pair twice is refused.
  *   - fallback_chain: chains are followed, cycles refused.
  *
@@ -105,7 +105,7 @@ START_TEST(cg_noconv_fallback_solve)
     OK(odhs_solver_set_param(cg, "maxiter", 1));
     ck_assert_int_eq(odhs_solver_solve(cg, net, b, x), ODHS_E_NOCONV);
     ck_assert(odhs_solver_errmsg(cg)[0] != '\0');
-    ck_assert(stat_of(cg, "fallbacks") == 0.0 && stat_of(cg, "fallback_last") == 0.0);
+    ck_assert(stat_of(cg, "chain_fallbacks") == 0.0 && stat_of(cg, "chain_last") == 0.0);
     double res_fail = stat_of(cg, "residual");
     ck_assert_msg(res_fail > 1e-3, "one CG iteration left a residual of only %g", res_fail);
 
@@ -113,9 +113,9 @@ START_TEST(cg_noconv_fallback_solve)
     OK(odhs_solver_set_fallback(cg, dn));
     memset(x, 0, nc * sizeof *x);
     OK(odhs_solver_solve(cg, net, b, x));
-    ck_assert(stat_of(cg, "fallbacks") == 1.0);
-    ck_assert(stat_of(cg, "fallback_rescued") == 1.0);
-    ck_assert(stat_of(cg, "fallback_last") == 1.0);
+    ck_assert(stat_of(cg, "chain_fallbacks") == 1.0);
+    ck_assert(stat_of(cg, "chain_rescued") == 1.0);
+    ck_assert(stat_of(cg, "chain_last") == 1.0);
     ck_assert(stat_of(dn, "solves") >= 1.0);
     ck_assert_ptr_nonnull(strstr(odhs_solver_errmsg(cg), "fallback dense"));
     /* the fallback's answer: N x = b and the dense-only solution */
@@ -130,10 +130,10 @@ START_TEST(cg_noconv_fallback_solve)
     ck_assert_msg(stat_of(cg, "residual") == stat_of(dn, "residual"), "residual statistic not the fallback's");
     ck_assert_msg(sqrt(rn / bn) < 1e-8, "relative residual %g", sqrt(rn / bn));
     ck_assert_msg(dx <= 1e-12 * xn, "fallback solution differs from dense by %g (scale %g)", dx, xn);
-    /* a solve that converges clears fallback_last; removing the fallback works */
+    /* a solve that converges clears chain_last; removing the fallback works */
     OK(odhs_solver_set_param(cg, "maxiter", 0));
     OK(odhs_solver_solve(cg, net, b, x));
-    ck_assert(stat_of(cg, "fallback_last") == 0.0 && stat_of(cg, "fallbacks") == 1.0);
+    ck_assert(stat_of(cg, "chain_last") == 0.0 && stat_of(cg, "chain_fallbacks") == 1.0);
     OK(odhs_solver_set_param(cg, "maxiter", 1));
     OK(odhs_solver_set_fallback(cg, NULL));
     memset(x, 0, nc * sizeof *x);
@@ -197,7 +197,7 @@ START_TEST(cg_noconv_stepper_rollback_and_recovery)
         OK(odhs_stepper_errors(a.st, NULL, &ov));
         ck_assert_msg(ov <= 1e-12, "overlap %g after recovery", ov);
     }
-    double nfb = stat_of(cg, "fallbacks"), nres = stat_of(cg, "fallback_rescued");
+    double nfb = stat_of(cg, "chain_fallbacks"), nres = stat_of(cg, "chain_rescued");
     ck_assert_msg(nfb >= 40 && nres == nfb, "fallbacks %g, rescued %g", nfb, nres);
     ck_assert_msg(worst <= 1e-9, "recovered run departs from the dense run by %g", worst);
     fprintf(stderr, "[numfail] stepper: capped cg rolled back; %g solves rescued by dense, max |dx| vs dense %.2e\n",
@@ -258,8 +258,8 @@ START_TEST(hyperstatic_crystal)
                   odhs_strerror(rc));
     const char *m = odhs_solver_errmsg(cg);
     ck_assert_msg(strstr(m, "cg") && strstr(m, "fallback dense failed too"), "message: %s", m);
-    ck_assert(stat_of(cg, "fallbacks") == 1.0 && stat_of(cg, "fallback_rescued") == 0.0);
-    ck_assert(stat_of(cg, "fallback_last") == 1.0);
+    ck_assert(stat_of(cg, "chain_fallbacks") == 1.0 && stat_of(cg, "chain_rescued") == 0.0);
+    ck_assert(stat_of(cg, "chain_last") == 1.0);
     free(b);
     free(x);
     odhs_solver_destroy(cg);
@@ -313,8 +313,8 @@ START_TEST(fallback_chain)
     for (size_t k = 0; k < nc; ++k) bb[k] = 1.0;
     OK(odhs_solver_solve(a, net, bb, x));
     /* a -> b2 (fails too) -> c (solves) */
-    ck_assert(stat_of(a, "fallbacks") == 1.0 && stat_of(a, "fallback_rescued") == 1.0);
-    ck_assert(stat_of(b2, "fallbacks") == 1.0 && stat_of(b2, "fallback_rescued") == 1.0);
+    ck_assert(stat_of(a, "chain_fallbacks") == 1.0 && stat_of(a, "chain_rescued") == 1.0);
+    ck_assert(stat_of(b2, "chain_fallbacks") == 1.0 && stat_of(b2, "chain_rescued") == 1.0);
     ck_assert(stat_of(a, "residual") < 1e-8);
     free(bb);
     free(x);

@@ -167,8 +167,8 @@ ODHS_API int odhs_solver_set_param(odhs_solver *s, const char *key, double value
  * |N x - b| / |b| of the last solve, computed by the library),
  * "backward_error" (|N x - b| / (|N| |x| + |b|) with |N| bounded by twice the
  * largest particle degree), "solves" (count), and with a fallback (see
- * odhs_solver_set_fallback) "fallbacks", "fallback_rescued",
- * "fallback_last".
+ * odhs_solver_set_fallback) "chain_fallbacks", "chain_rescued",
+ * "chain_last".
  */
 ODHS_API int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value);
 /** Set the normwise backward error above which a solve is reported as failed
@@ -195,8 +195,8 @@ ODHS_API int odhs_solver_set_refinement(odhs_solver *s, int steps);
  * statistics are the fallback's) and the error message of s records what
  * happened; otherwise the fallback's error is returned. Other errors
  * (NULL, non-finite input, out of memory) are returned as they are.
- * Statistics of s: "fallbacks" (solves handed to the fallback),
- * "fallback_rescued" (of those, solved by it), "fallback_last" (1 if the last
+ * Statistics of s: "chain_fallbacks" (solves handed to the fallback),
+ * "chain_rescued" (of those, solved by it), "chain_last" (1 if the last
  * solve was handed over, else 0). The fallback is borrowed: it must outlive
  * s (or be removed first) and must not be used concurrently by another
  * thread. NULL removes it (the default). ODHS_E_INVALID if the chain of
