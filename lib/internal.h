@@ -221,6 +221,8 @@ struct odhs_network {
     int bc_valid;
     uint64_t bc_topo;
     unsigned char *bcore;  /* n flags */
+    size_t *bc_mem;        /* scratch of the body-level subset (8n + 2), allocated with the first bond */
+    unsigned char *bc_in;  /* scratch (n) */
     size_t bnbar, bncon;
     char errmsg[ODHS_ERRMSG_LEN];
 };

@@ -129,6 +129,8 @@ void odhs_network_destroy(odhs_network *net)
     odhs__free(net->rest);
     odhs__free(net->rbody);
     odhs__free(net->bcore);
+    odhs__free(net->bc_mem);
+    odhs__free(net->bc_in);
     odhs__free(net->hkey);
     odhs__free(net->hval);
     if (net->adj)
@@ -308,8 +310,19 @@ static void core_edge_removed(odhs_network *net, size_t i, size_t j)
     if (net->core[j]) net->cdeg[i]--;
 }
 
+/* the body-level subset's arrays, allocated once, with the first bond */
+static int bc_reserve(odhs_network *net)
+{
+    size_t n = net->n ? net->n : 1;
+    if (!net->bcore && !(net->bcore = odhs__malloc_array(n, 1))) return ODHS_E_NOMEM;
+    if (!net->bc_in && !(net->bc_in = odhs__malloc_array(n, 1))) return ODHS_E_NOMEM;
+    if (!net->bc_mem && !(net->bc_mem = odhs__malloc_array(8 * n + 2, sizeof *net->bc_mem))) return ODHS_E_NOMEM;
+    return ODHS_OK;
+}
+
 size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
 {
+    if (kind == ODHS_CONTACT_PERMANENT && bc_reserve(net)) return SIZE_MAX;
     if (i > j) {
         size_t t = i;
         i = j;
@@ -737,15 +750,11 @@ int odhs__net_body_core(const odhs_network *cnet)
     if (net->bc_valid && net->bc_topo == net->topo) return ODHS_OK;
     net->work_composite++;
     size_t n = net->n, d = (size_t)net->dim;
-    if (!net->bcore && !(net->bcore = odhs__malloc_array(n ? n : 1, 1))) return ODHS_E_NOMEM;
-    /* parent, bid, start (n+1), beads, kb, dof, cnt, queue */
-    size_t *mem = odhs__malloc_array(8 * n + 2, sizeof *mem);
-    unsigned char *in = odhs__malloc_array(n ? n : 1, 1);
-    if (!mem || !in) {
-        odhs__free(mem);
-        odhs__free(in);
-        return ODHS_E_NOMEM;
-    }
+    /* scratch allocated with the first bond (bc_reserve), so that queries
+     * never allocate: parent, bid, start (n+1), beads, kb, dof, cnt, queue */
+    if (!net->bcore || !net->bc_mem || !net->bc_in) return ODHS_E_INTERNAL;
+    size_t *mem = net->bc_mem;
+    unsigned char *in = net->bc_in;
     size_t *parent = mem, *bid = mem + n, *start = mem + 2 * n, *beads = mem + 3 * n + 1;
     size_t *kb = mem + 4 * n + 1, *dof = mem + 5 * n + 1, *cnt = mem + 6 * n + 1, *q = mem + 7 * n + 1;
     for (size_t i = 0; i < n; ++i) parent[i] = i;
@@ -820,8 +829,6 @@ int odhs__net_body_core(const odhs_network *cnet)
     net->bncon = ncon;
     net->bc_valid = 1;
     net->bc_topo = net->topo;
-    odhs__free(mem);
-    odhs__free(in);
     return ODHS_OK;
 }
 
@@ -887,6 +894,7 @@ int odhs_network_add_bond(odhs_network *net, size_t i, size_t j, double rest)
     if (k == SIZE_MAX && (k = odhs__net_add(net, i, j, ODHS_CONTACT_PERMANENT)) == SIZE_MAX)
         return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
     if (net->kind[k] != ODHS_CONTACT_PERMANENT) {
+        if (bc_reserve(net)) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
         /* a temporary contact becomes a bond: same constraint, new kind */
         net->kind[k] = ODHS_CONTACT_PERMANENT;
         net->nperm++;
