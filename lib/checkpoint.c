@@ -540,8 +540,9 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         for (uint64_t q = 0; q < np; ++q) {
             uint64_t c = get_u64(&b);
             double rest = get_f64(&b);
-            if (b.bad || c >= net->nc || net->kind[c] != ODHS_CONTACT_PERMANENT || !(rest > 0.0) ||
-                !isfinite(rest))
+            /* NaN: the bond's rest length is a_i + a_j (odhs_network_add) */
+            if (b.bad || c >= net->nc || net->kind[c] != ODHS_CONTACT_PERMANENT ||
+                (!isnan(rest) && (!(rest > 0.0) || !isfinite(rest))))
                 FAIL(ODHS_E_FORMAT, "checkpoint: bad bond %llu", (unsigned long long)q);
             net->rest[c] = rest;
         }

@@ -6,6 +6,7 @@
  * line, x += tau (G x + U), and deforms the box with the same G, so every pair
  * separation is linear in time and collision times are exact roots of a
  * quadratic. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -787,6 +788,12 @@ static void rollback(odhs_stepper *st)
     memcpy(st->F, st->Fs, st->nd * sizeof *st->F);
     st->has_F = st->has_Fs;
     st->nb_stale = 1; /* rebuild the neighbour list before the next step */
+    /* its displacement record may hold the failed step's motion (even a
+     * non-finite one): the rebuild starts it afresh, so clear it now (a
+     * checkpoint taken before the next step must not carry it) */
+    memset(st->disp, 0, st->nd * sizeof *st->disp);
+    memset(st->M, 0, sizeof st->M);
+    for (int a = 0; a < 3; ++a) st->M[3 * (a) + (a)] = 1.0;
 }
 
 /* ---- lifecycle ------------------------------------------------------------- */
@@ -1090,6 +1097,8 @@ static int restart_step(odhs_stepper *st)
  * tiny h set h to 0 and the integrator stalls forever (found by fuzzing the
  * checkpoint reader). */
 #define HEUN_HMIN 1e-12
+/* the smallest adaptive step: HEUN_HMIN dt, and never 0 (dt may be tiny) */
+static double heun_hmin(const odhs_stepper *st) { return fmax(HEUN_HMIN * st->dt, fmin(st->dt, DBL_MIN)); }
 
 static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
 {
@@ -1150,7 +1159,7 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
             memcpy(st->U, st->U0, nd * sizeof *st->U);
             st->nrejected++;
             if (attempt < 20) {
-                st->h *= 0.25;
+                st->h = fmax(0.25 * st->h, heun_hmin(st));
                 continue;
             }
             memcpy(st->Ua, st->U0, nd * sizeof *st->Ua);
@@ -1178,12 +1187,12 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
             }
             for (int a = 0; a < 9; ++a) Ga[a] = 0.5 * (G0[a] + Gs[a]);
             memcpy(st->U, st->U0, nd * sizeof *st->U);
-            if (!truncated) st->h = fmin(st->dt, fmax(st->h * fmin(2.0, fac), HEUN_HMIN * st->dt));
+            if (!truncated) st->h = fmin(st->dt, fmax(st->h * fmin(2.0, fac), heun_hmin(st)));
             *tau_out = tau;
             return ODHS_OK;
         }
         st->nrejected++;
-        st->h = fmax(st->h * fmax(0.2, fac), HEUN_HMIN * st->dt);
+        st->h = fmax(st->h * fmax(0.2, fac), heun_hmin(st));
     }
 }
 
