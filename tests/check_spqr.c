@@ -36,103 +36,17 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_spqr;
 /* helpers                                                                   */
 /* ------------------------------------------------------------------------ */
 
-#define CK_OK(call)                                                                \
-    do {                                                                           \
-        int ck_st_ = (call);                                                       \
-        ck_assert_msg(ck_st_ == ODHS_OK, "%s = %d (%s)", #call, ck_st_, odhs_strerror(ck_st_)); \
-    } while (0)
+#include "netcase.h"
 
-static void *xcalloc(size_t n, size_t size)
-{
-    void *p = calloc(n ? n : 1, size);
-    ck_assert_ptr_nonnull(p);
-    return p;
-}
+typedef tu_netcase sp_case;
+#define sp_case_free tu_netcase_free
+#define sp_case_refresh tu_netcase_refresh
+#define sp_make tu_netcase_make
 
-typedef struct {
-    odhs_system *sys;
-    odhs_network *net;
-    size_t n, nc, nd;
-    int dim;
-} sp_case;
-
-static void sp_case_free(sp_case *c)
-{
-    odhs_network_destroy(c->net);
-    odhs_system_destroy(c->sys);
-    memset(c, 0, sizeof *c);
-}
-
-static void sp_case_refresh(sp_case *c)
-{
-    c->nc = odhs_network_count(c->net);
-    c->n = odhs_network_particles(c->net);
-    c->dim = odhs_network_dim(c->net);
-    c->nd = c->n * (size_t)c->dim;
-}
-
-/* a system from L, r, x and an empty network on it */
-static sp_case sp_make(int dim, size_t n, const double *L, double gamma, const double *r, const double *x)
-{
-    sp_case c;
-    memset(&c, 0, sizeof c);
-    CK_OK(odhs_system_create(dim, n, &c.sys));
-    CK_OK(odhs_system_set_configuration(c.sys, L, gamma, r, x));
-    CK_OK(odhs_network_create(c.sys, &c.net));
-    sp_case_refresh(&c);
-    return c;
-}
-
-static size_t uf_find(size_t *p, size_t i)
-{
-    while (p[i] != i) {
-        p[i] = p[p[i]];
-        i = p[i];
-    }
-    return i;
-}
-
-/* Random polydisperse configuration under Lees-Edwards strain; contacts = a
- * random spanning forest of the pairs with gap <= maxgap (independent rows of
- * S: peel the leaves) plus `extra` pairs closing cycles (generic positions
- * keep S of full row rank). With extra = SIZE_MAX every near pair is a
- * contact (over-constrained networks). */
 static sp_case sp_random_case_gap(int dim, size_t n, uint64_t seed, size_t extra, double maxgap)
 {
-    tu_rng rng;
-    tu_rng_seed(&rng, seed);
-    double *r = xcalloc(n, sizeof *r), *x = xcalloc(n * dim, sizeof *x), L[3], vol = 0.0;
-    tu_radii_loguniform(n, 0.4, 0.7, r, &rng);
-    for (size_t i = 0; i < n; ++i) vol += dim == 2 ? TU_PI * r[i] * r[i] : 4.0 / 3.0 * TU_PI * pow(r[i], 3);
-    double side = dim == 2 ? sqrt(vol / 0.35) : cbrt(vol / 0.2);
-    for (int k = 0; k < dim; ++k) L[k] = side * (1.0 + 0.05 * k);
-    double gamma = 0.13;
-    ck_assert_msg(tu_random_config(dim, n, L, gamma, r, 1e-9, x, &rng), "RSA failed");
-    sp_case c = sp_make(dim, n, L, gamma, r, x);
-    tu_pairlist pl;
-    tu_brute_pairs(dim, n, x, r, L, gamma, maxgap, &pl);
-    for (size_t k = pl.n; k > 1; --k) {
-        size_t m = tu_index(&rng, k);
-        tu_pair t = pl.p[k - 1];
-        pl.p[k - 1] = pl.p[m];
-        pl.p[m] = t;
-    }
-    size_t *par = xcalloc(n, sizeof *par), added = 0;
-    for (size_t i = 0; i < n; ++i) par[i] = i;
-    for (size_t k = 0; k < pl.n; ++k) {
-        size_t a = uf_find(par, pl.p[k].i), b = uf_find(par, pl.p[k].j);
-        if (a != b) par[a] = b;
-        else if (added < extra) added++;
-        else continue;
-        CK_OK(odhs_network_add(c.net, pl.p[k].i, pl.p[k].j, ODHS_CONTACT_TEMPORARY));
-    }
-    CK_OK(odhs_network_update_geometry(c.net, c.sys));
-    sp_case_refresh(&c);
+    sp_case c = tu_netcase_random(dim, n, seed, extra, maxgap, 0.13);
     ck_assert_msg(c.nc >= n / 2, "only %zu contacts", c.nc);
-    tu_pairlist_free(&pl);
-    free(par);
-    free(r);
-    free(x);
     return c;
 }
 
