@@ -966,24 +966,7 @@ END_TEST
 START_TEST(test_stepper_shear)
 {
     const size_t n = 64;
-    odhs_system *base;
-    CK_OK(odhs_system_create(2, n, &base));
-    CK_OK(odhs_system_set_radii_bidisperse(base, 0.5, 1.4, 0.03, 801));
-    CK_OK(odhs_system_place_random(base, 0.45, 801));
-    {
-        odhs_driver *drv;
-        odhs_solver *sol;
-        odhs_stepper *st;
-        CK_OK(odhs_driver_create(&drv));
-        CK_OK(odhs_driver_set_compression_rate(drv, 1.0));
-        CK_OK(odhs_solver_create_by_name("dense", &sol));
-        CK_OK(odhs_stepper_create(base, drv, sol, &st));
-        CK_OK(odhs_stepper_run_until_packing_fraction(st, 0.78));
-        CK_OK(odhs_stepper_correct(st));
-        odhs_stepper_destroy(st);
-        odhs_solver_destroy(sol);
-        odhs_driver_destroy(drv);
-    }
+    odhs_system *base = tu_compressed_discs(n, 801, 0.78);
     odhs_system *sys[2];
     odhs_driver *drv[2];
     odhs_solver *sol[2];

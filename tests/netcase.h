@@ -107,4 +107,28 @@ static inline tu_netcase tu_netcase_random(int dim, size_t n, uint64_t seed, siz
     return c;
 }
 
+/* n 50:50 bidisperse discs (ratio 1.4, 3% polydispersity) placed at random at
+ * phi = 0.45, compressed to phi by the event-driven stepper (dense solver) and
+ * drift-corrected: a dense start for the solver suites' stepper runs */
+static inline odhs_system *tu_compressed_discs(size_t n, uint64_t seed, double phi)
+{
+    odhs_system *base;
+    odhs_driver *drv;
+    odhs_solver *sol;
+    odhs_stepper *st;
+    CK_OK(odhs_system_create(2, n, &base));
+    CK_OK(odhs_system_set_radii_bidisperse(base, 0.5, 1.4, 0.03, seed));
+    CK_OK(odhs_system_place_random(base, 0.45, seed));
+    CK_OK(odhs_driver_create(&drv));
+    CK_OK(odhs_driver_set_compression_rate(drv, 1.0));
+    CK_OK(odhs_solver_create_by_name("dense", &sol));
+    CK_OK(odhs_stepper_create(base, drv, sol, &st));
+    CK_OK(odhs_stepper_run_until_packing_fraction(st, phi));
+    CK_OK(odhs_stepper_correct(st));
+    odhs_stepper_destroy(st);
+    odhs_solver_destroy(sol);
+    odhs_driver_destroy(drv);
+    return base;
+}
+
 #endif /* ODHS_TESTS_NETCASE_H */
