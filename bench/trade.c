@@ -71,6 +71,7 @@ typedef struct {
     int integrator;
     double dt, tol;
     unsigned corr;
+    int defaults; /* 1: the library's default settings (no set_* call) */
 } setting;
 
 typedef struct {
@@ -93,10 +94,12 @@ static int run(const odhs_system *start, const char *solver, const setting *s, d
     odhs_driver_create(&drv);
     odhs_driver_set_shear_rate(drv, 1.0);
     odhs_stepper_create(sys, drv, sol, &st);
-    odhs_stepper_set_integrator(st, s->integrator);
-    odhs_stepper_set_dt(st, s->dt);
-    if (s->tol > 0) odhs_stepper_set_tolerance(st, s->tol);
-    odhs_stepper_set_correction_interval(st, s->corr);
+    if (!s->defaults) {
+        odhs_stepper_set_integrator(st, s->integrator);
+        odhs_stepper_set_dt(st, s->dt);
+        if (s->tol > 0) odhs_stepper_set_tolerance(st, s->tol);
+        odhs_stepper_set_correction_interval(st, s->corr);
+    }
     r->gap = 0.0;
     r->rc = 0;
     double t0 = now(), c0 = cpu_now();
@@ -145,6 +148,7 @@ int main(int argc, char **argv)
     odhs_driver_create(&drv);
     odhs_driver_set_compression_rate(drv, 1.0);
     odhs_stepper_create(sys, drv, cg, &st);
+    odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER); /* the start: Euler dt 1e-3, correction every 10 */
     if (odhs_stepper_run_until_packing_fraction(st, 0.80) || odhs_stepper_correct(st)) {
         fprintf(stderr, "trade: building the start failed: %s\n", odhs_stepper_errmsg(st));
         return 1;
@@ -159,24 +163,30 @@ int main(int argc, char **argv)
            "time)\n", cpu, odhs_version_string(), la[0], la[1], la[2]);
     printf("# N = %zu 2D bidisperse, phi = 0.80, shear to strain %g; paper settings: cg, others: %s\n", n,
            gamma, solver);
-    setting ref = {"reference heun tol 1e-11, corr 1", ODHS_INTEGRATOR_HEUN, 1e-3, 1e-11, 1};
+    setting ref = {"reference heun tol 1e-11, corr 1", ODHS_INTEGRATOR_HEUN, 1e-3, 1e-11, 1, 0};
     setting set[] = {
-        {"paper euler dt 1e-4 corr 10", ODHS_INTEGRATOR_EULER, 1e-4, 0, 10},
-        {"paper euler dt 1e-5 corr 10", ODHS_INTEGRATOR_EULER, 1e-5, 0, 10},
-        {"paper euler dt 1e-6 corr 10", ODHS_INTEGRATOR_EULER, 1e-6, 0, 10},
-        {"euler dt 1e-5 corr 1", ODHS_INTEGRATOR_EULER, 1e-5, 0, 1},
-        {"euler dt 1e-5 corr 100", ODHS_INTEGRATOR_EULER, 1e-5, 0, 100},
-        {"heun tol 1e-3", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-3, 10},
-        {"heun tol 1e-4", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-4, 10},
-        {"heun tol 1e-5", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-5, 10},
-        {"heun tol 1e-6", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-6, 10},
-        {"heun tol 1e-7", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-7, 10},
-        {"heun tol 1e-8", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-8, 10},
-        {"heun tol 1e-9", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-9, 10},
-        {"heun tol 1e-10", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-10, 10},
-        {"heun tol 1e-8 corr 100", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-8, 100},
+        {"paper euler dt 1e-4 corr 10", ODHS_INTEGRATOR_EULER, 1e-4, 0, 10, 0},
+        {"paper euler dt 1e-5 corr 10", ODHS_INTEGRATOR_EULER, 1e-5, 0, 10, 0},
+        {"paper euler dt 1e-6 corr 10", ODHS_INTEGRATOR_EULER, 1e-6, 0, 10, 0},
+        {"paper euler dt 1e-7 corr 10", ODHS_INTEGRATOR_EULER, 1e-7, 0, 10, 0},
+        {"default settings", ODHS_INTEGRATOR_HEUN, 0, 0, 0, 1},
+        {"euler dt 1e-5 corr 1", ODHS_INTEGRATOR_EULER, 1e-5, 0, 1, 0},
+        {"euler dt 1e-5 corr 100", ODHS_INTEGRATOR_EULER, 1e-5, 0, 100, 0},
+        {"heun tol 1e-3", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-3, 10, 0},
+        {"heun tol 1e-3 corr 1", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-3, 1, 0},
+        {"heun tol 1e-4", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-4, 10, 0},
+        {"heun tol 1e-5", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-5, 10, 0},
+        {"heun tol 1e-6", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-6, 10, 0},
+        {"heun tol 1e-7", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-7, 10, 0},
+        {"heun tol 1e-8", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-8, 10, 0},
+        {"heun tol 1e-9", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-9, 10, 0},
+        {"heun tol 1e-10", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-10, 10, 0},
+        {"heun tol 1e-8 corr 100", ODHS_INTEGRATOR_HEUN, 1e-2, 1e-8, 100, 0},
     };
     size_t nset = sizeof set / sizeof set[0];
+    /* paper dt 1e-7 costs ~10 minutes at N = 1000: only with ODHS_TRADE_PAPER_1E7=1 */
+    const char *p7 = getenv("ODHS_TRADE_PAPER_1E7");
+    int with_p7 = p7 && atoi(p7) > 0;
     result R;
     if (run(sys, solver, &ref, gamma, &R)) {
         fprintf(stderr, "trade: reference run failed (%d)\n", R.rc);
@@ -201,6 +211,11 @@ int main(int argc, char **argv)
     for (size_t k = 0; k < nset; ++k) {
         result r;
         memset(&r, 0, sizeof r);
+        if (set[k].dt == 1e-7 && !with_p7) {
+            r.rc = 1; /* skipped, not failed */
+            keep[k] = r;
+            continue;
+        }
         int rc = run(sys, solver, &set[k], gamma, &r);
         if (k == 1) t_paper5 = r.cpu;
         double s2 = 0.0, mx = 0.0, serr = 0.0;
@@ -251,6 +266,69 @@ int main(int argc, char **argv)
             printf("# %s (%.2f s CPU): fastest at least as accurate: %s, %.2f s CPU, speed ratio %.1f\n",
                    set[p].label, keep[p].cpu, set[best].label, keep[best].cpu, keep[p].cpu / keep[best].cpu);
     }
+    /* the library's default settings against paper mode at equal or better
+     * accuracy: a paper setting that is no more accurate than the defaults in
+     * any of the three errors gives a measured lower bound of the ratio at
+     * equal accuracy (paper mode would need a smaller dt, hence more time, to
+     * match); the dt at which paper mode would match, from power laws fitted
+     * to the paper rows (error ~ dt^a, time ~ dt^-b), gives an estimate */
+    size_t kd = nset;
+    for (size_t k = 0; k < nset; ++k)
+        if (set[k].defaults && !keep[k].rc) kd = k;
+    if (kd < nset) {
+        const result *D = &keep[kd];
+        printf("# default settings (heun tol 1e-6, correction every step, dt 1e-3, solver %s): %.2f s CPU; "
+               "rms %.2e, gap %.2e, stress %.2e\n", solver, D->cpu, D->rms, D->gap, D->stress_err);
+        double best_lb = 0.0;
+        size_t kb = nset;
+        double lx[4], le[3][4], lt[4];
+        int np = 0;
+        for (size_t p = 0; p < nset; ++p) {
+            if (strncmp(set[p].label, "paper", 5) || keep[p].rc) continue;
+            const result *P = &keep[p];
+            int worse = P->rms >= D->rms && P->gap >= D->gap && P->stress_err >= D->stress_err;
+            printf("#   vs %s (%.2f s CPU): %.1fx faster; paper/default errors: rms %.3g, gap %.3g, stress %.3g; %s\n",
+                   set[p].label, P->cpu, P->cpu / D->cpu, P->rms / D->rms, P->gap / D->gap,
+                   P->stress_err / D->stress_err,
+                   worse ? "defaults at least as accurate in all three" : "paper more accurate in some error");
+            if (worse && P->cpu / D->cpu > best_lb) {
+                best_lb = P->cpu / D->cpu;
+                kb = p;
+            }
+            if (np < 4) {
+                lx[np] = log(set[p].dt);
+                le[0][np] = log(P->rms);
+                le[1][np] = log(P->gap);
+                le[2][np] = log(P->stress_err);
+                lt[np] = log(P->cpu);
+                np++;
+            }
+        }
+        if (kb < nset)
+            printf("# equal or better accuracy: the defaults are at least as accurate as %s and %.1fx faster (measured "
+                   "lower bound of the ratio at equal accuracy)\n", set[kb].label, best_lb);
+        if (np >= 2) {
+            /* least-squares lines in log-log; dt* = the largest dt at which all
+             * three fitted paper errors are <= the defaults' */
+            double ldt = INFINITY;
+            for (int e = 0; e < 3; ++e) {
+                double mx = 0, my = 0, sxx = 0, sxy = 0;
+                for (int q = 0; q < np; ++q) mx += lx[q] / np, my += le[e][q] / np;
+                for (int q = 0; q < np; ++q) sxx += (lx[q] - mx) * (lx[q] - mx), sxy += (lx[q] - mx) * (le[e][q] - my);
+                double a = sxy / sxx, c = my - a * mx;
+                double target = log(e == 0 ? D->rms : e == 1 ? D->gap : D->stress_err);
+                if (a > 0) ldt = fmin(ldt, (target - c) / a);
+            }
+            double mx = 0, my = 0, sxx = 0, sxy = 0;
+            for (int q = 0; q < np; ++q) mx += lx[q] / np, my += lt[q] / np;
+            for (int q = 0; q < np; ++q) sxx += (lx[q] - mx) * (lx[q] - mx), sxy += (lx[q] - mx) * (lt[q] - my);
+            double b = sxy / sxx, c = my - b * mx;
+            if (isfinite(ldt))
+                printf("# paper mode would match the defaults in all three errors at dt ~ %.2g (fit of %d paper rows): "
+                       "~%.3g s CPU (fit time ~ dt^%.2f), ~%.0fx the defaults (extrapolated)\n", exp(ldt), np,
+                       exp(c + b * ldt), b, exp(c + b * ldt) / D->cpu);
+        }
+    }
     /* plot: rms position error against CPU time */
     pl_plot pp;
     char title[160];
@@ -263,11 +341,17 @@ int main(int argc, char **argv)
     snprintf(hl, sizeof hl, "heun (adaptive), %s, corr 10", solver);
     fam[2] = pl_series_add(&pp, hl, 0, 0, 1);
     fam[3] = pl_series_add(&pp, "heun tol 1e-8, corr 100", 2, 1, 4);
+    int famd = pl_series_add(&pp, "default settings", 4, 0, 5);
+    pp.s[famd].lines = 0;
     pp.s[fam[1]].lines = 0;
     pp.s[fam[3]].lines = 0;
     for (size_t k = 0; k < nset; ++k) {
         if (keep[k].rc) continue;
         const char *l = set[k].label;
+        if (set[k].defaults) {
+            pl_point_label(&pp, famd, keep[k].cpu, keep[k].rms, "defaults");
+            continue;
+        }
         int f = !strncmp(l, "paper", 5) ? 0 : !strncmp(l, "euler", 5) ? 1 : strstr(l, "corr") ? 3 : 2;
         char lab[24];
         if (f == 0) snprintf(lab, sizeof lab, "dt %.0e", set[k].dt);

@@ -30,7 +30,8 @@ static void usage(FILE *f)
             "  --seed S           built-in scene: random seed (default 1)\n"
             "  --solver NAME      linear solver (default cholmod-pcg when built with\n"
             "                     SuiteSparse, else dense up to N = 2000 and cg above)\n"
-            "  --dt X             step in natural units (default 1e-3)\n"
+            "  --dt X             step of the paper's explicit Euler scheme, which this\n"
+            "                     program uses, in natural units (default 1e-3)\n"
             "  --max-strain X     shear protocols: give up after this strain (default 20)\n"
             "  --correction K     drift correction every K steps (default 1: certified\n"
             "                     packings need contact gaps at round-off when they jam)\n"
@@ -132,7 +133,8 @@ int main(int argc, char **argv)
     }
     odhs_driver *drv;
     odhs_stepper *st;
-    if (odhs_driver_create(&drv) || odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt) ||
+    if (odhs_driver_create(&drv) || odhs_stepper_create(sys, drv, solver, &st) ||
+        odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER) || odhs_stepper_set_dt(st, dt) ||
         odhs_stepper_set_correction_interval(st, (unsigned)corr)) {
         fprintf(stderr, "jam_packing: setup failed\n");
         return 1;
@@ -154,7 +156,8 @@ int main(int argc, char **argv)
             odhs_system_scale_box(sys, pow(1.002, 1.0 / odhs_system_dim(sys)));
             odhs_driver_set_compression_rate(drv, 0.0);
             odhs_driver_set_shear_rate(drv, 1.0);
-            if (odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt) ||
+            if (odhs_stepper_create(sys, drv, solver, &st) ||
+                odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER) || odhs_stepper_set_dt(st, dt) ||
                 odhs_stepper_set_correction_interval(st, (unsigned)corr))
                 return 1;
             fprintf(stderr, "jam_packing: compression jammed at phi = %.6f; shearing at phi = %.6f\n", phi,

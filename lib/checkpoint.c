@@ -457,6 +457,7 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         FAIL(ODHS_E_FORMAT, "checkpoint: stepper section malformed");
     st->integrator = (int)integ;
     st->corr_every = (unsigned)corr;
+    st->corr_user = 1; /* the file's interval is kept by set_integrator */
     st->jammed = (int)jam;
     st->nb_stale = (int)stale;
     double sc[] = {st->dt, st->tol, st->h, st->lambda, st->contact_tol, st->time, st->strain, st->tau,

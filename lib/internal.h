@@ -194,15 +194,15 @@ struct odhs_network {
     uint64_t *hkey;  /* 0 = empty, else i*n + j + 1 */
     size_t *hval;
     uint64_t version; /* bumped on every change of contacts or geometry */
-    /* constrained subset (the (d+1)-core of the contact graph), maintained
-     * incrementally on every add/remove, in integers */
+    /* constrained subset (the (d+1)-core of the contact graph), in integers:
+     * peeled incrementally on every removal, rebuilt lazily after additions */
     size_t **adj;          /* per particle: partners */
     uint32_t *adjn, *adjcap;
     unsigned char *core;   /* 1 = in the constrained subset */
     size_t *cdeg;          /* number of neighbours in the core */
     size_t nbar, ncon;     /* core size, contacts inside the core */
+    int core_stale;        /* contacts added since: the core may have grown (rebuilt on query) */
     size_t *work;          /* scratch: queue (n) */
-    unsigned char *mark;   /* scratch flags (n) */
     /* composites (Sect. V C); untouched by scenes without permanent contacts */
     double *rest;          /* cap: rest length of each permanent contact (NAN: a_i + a_j) */
     size_t nperm;          /* number of permanent contacts */
@@ -212,7 +212,7 @@ struct odhs_network {
     uint64_t topo;         /* bumped when contacts are added, removed or change kind */
     uint64_t work_composite; /* passes of composite-only code (odhs_stepper_feature_work) */
     /* hard walls: contacts (i, n + w) of kind ODHS_CONTACT_WALL; the per-node
-     * arrays (adj, core, cdeg, mark, work) have room for n + nwalls nodes and
+     * arrays (adj, core, cdeg, work) have room for n + nwalls nodes and
      * wall nodes are always in the constrained subset */
     odhs_wall *walls;
     size_t nwalls;
@@ -372,6 +372,10 @@ struct odhs_stepper {
     double h;         /* adaptive: current step in units of tau */
     double lambda;    /* mean diameter */
     double *U0, *Ua;  /* adaptive: velocities at the start, averaged (nd) */
+    double *Up;       /* adaptive: predictor velocities U* of the accepted step (nd) */
+    double Gp[9], taup; /* ... its gradient and step length */
+    int pred_ok;      /* Up, Gp, taup belong to the current step */
+    int corr_user;    /* the correction interval was set (not the integrator's default) */
     double *disps;    /* adaptive: displacement record at the start (nd) */
     double Ms[9];
     uint64_t nrejected, nsolves_pred;

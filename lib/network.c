@@ -98,8 +98,7 @@ odhs_network *odhs__net_new(int dim, size_t n)
     net->core = odhs__calloc(n, 1);
     net->cdeg = odhs__calloc(n, sizeof *net->cdeg);
     net->work = odhs__calloc(2 * n + 2, sizeof *net->work);
-    net->mark = odhs__calloc(n, 1);
-    if (!net->adj || !net->adjn || !net->adjcap || !net->core || !net->cdeg || !net->work || !net->mark ||
+    if (!net->adj || !net->adjn || !net->adjcap || !net->core || !net->cdeg || !net->work ||
         grow(net)) {
         odhs_network_destroy(net);
         return NULL;
@@ -142,7 +141,6 @@ void odhs_network_destroy(odhs_network *net)
     odhs__free(net->core);
     odhs__free(net->cdeg);
     odhs__free(net->work);
-    odhs__free(net->mark);
     odhs__free(net);
 }
 
@@ -192,18 +190,6 @@ static void adj_remove(odhs_network *net, size_t i, size_t j)
         }
 }
 
-/* x joins the core: count its contacts to core members, tell its partners */
-static void core_join(odhs_network *net, size_t x)
-{
-    net->core[x] = 1;
-    net->nbar++;
-    for (uint32_t k = 0; k < net->adjn[x]; ++k) {
-        size_t y = net->adj[x][k];
-        net->cdeg[y]++;
-        if (net->core[y]) net->ncon++;
-    }
-}
-
 /* peel core members whose core degree fell below d+1, starting from queue */
 static void core_peel(odhs_network *net, size_t qt)
 {
@@ -226,6 +212,12 @@ static void core_peel(odhs_network *net, size_t qt)
     }
 }
 
+/* A contact added outside the core can only make the core grow. The growth
+ * is not searched for here: a search from the new contact walks the whole
+ * non-core cluster (O(N) per contact, O(N^2) for a network built contact by
+ * contact). The core is marked stale instead and rebuilt once, in O(N + Nc),
+ * by the next query (core_ensure). The stale core stays a valid set (every
+ * member keeps d+1 partners inside it), so removals keep updating it. */
 static void core_edge_added(odhs_network *net, size_t i, size_t j)
 {
     size_t need = (size_t)net->dim + 1;
@@ -237,62 +229,24 @@ static void core_edge_added(odhs_network *net, size_t i, size_t j)
     }
     if (net->core[i]) net->cdeg[j]++;
     if (net->core[j]) net->cdeg[i]++;
-    /* candidates: non-core particles with >= d+1 contacts reachable from the
-     * new contact through non-core particles */
-    size_t *q = net->work, qt = 0;
-    unsigned char *inC = net->mark;
-    size_t ends[2] = {i, j};
-    for (int e = 0; e < 2; ++e) {
-        size_t x = ends[e];
-        if (!net->core[x] && !inC[x] && net->adjn[x] >= need) {
-            inC[x] = 1;
-            q[qt++] = x;
-        }
+    if ((!net->core[i] && net->adjn[i] >= need) || (!net->core[j] && net->adjn[j] >= need)) net->core_stale = 1;
+}
+
+/* rebuild the core from scratch: every node in, then peel (O(N + Nc)) */
+static void core_ensure(const odhs_network *cnet)
+{
+    odhs_network *net = (odhs_network *)cnet; /* a cache: the set is a function of the contacts */
+    if (!net->core_stale) return;
+    size_t need = (size_t)net->dim + 1, nn = net->n + net->nwalls, qt = 0;
+    for (size_t x = 0; x < nn; ++x) {
+        net->core[x] = 1;
+        net->cdeg[x] = net->adjn[x];
+        if (x < net->n && net->cdeg[x] < need) net->work[qt++] = x;
     }
-    for (size_t h = 0; h < qt; ++h) {
-        size_t x = q[h];
-        for (uint32_t k = 0; k < net->adjn[x]; ++k) {
-            size_t y = net->adj[x][k];
-            if (!net->core[y] && !inC[y] && net->adjn[y] >= need) {
-                inC[y] = 1;
-                q[qt++] = y;
-            }
-        }
-    }
-    if (qt == 0) return;
-    /* peel the candidates: cnt = core partners + candidate partners. cdeg of
-     * candidates is only read here, so use it to hold cnt temporarily. */
-    size_t nC = qt;
-    for (size_t h = 0; h < nC; ++h) {
-        size_t x = q[h], cnt = net->cdeg[x];
-        for (uint32_t k = 0; k < net->adjn[x]; ++k) cnt += inC[net->adj[x][k]];
-        net->cdeg[x] = cnt;
-    }
-    /* iterative removal with a queue (candidates whose count drops below d+1
-     * are queued once, when they cross); removed candidates get inC = 2 */
-    size_t *rq = q + nC, rh = 0, rt = 0;
-    for (size_t h = 0; h < nC; ++h)
-        if (net->cdeg[q[h]] < need) rq[rt++] = q[h];
-    while (rh < rt) {
-        size_t x = rq[rh++];
-        if (inC[x] != 1) continue;
-        inC[x] = 2;
-        for (uint32_t k = 0; k < net->adjn[x]; ++k) {
-            size_t y = net->adj[x][k];
-            if (inC[y] == 1 && net->cdeg[y]-- == need) rq[rt++] = y;
-        }
-    }
-    /* restore cdeg of candidates to "core partners" and admit the survivors */
-    for (size_t h = 0; h < nC; ++h) {
-        size_t x = q[h], c = 0;
-        for (uint32_t k = 0; k < net->adjn[x]; ++k) c += net->core[net->adj[x][k]];
-        net->cdeg[x] = c;
-    }
-    for (size_t h = 0; h < nC; ++h) {
-        size_t x = q[h];
-        if (inC[x] == 1) core_join(net, x);
-    }
-    for (size_t h = 0; h < nC; ++h) inC[q[h]] = 0;
+    net->nbar = net->n;
+    net->ncon = net->nc;
+    core_peel(net, qt);
+    net->core_stale = 0;
 }
 
 static void core_edge_removed(odhs_network *net, size_t i, size_t j)
@@ -836,6 +790,7 @@ int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon
                              unsigned char *in_subset, long *zbar_num)
 {
     if (!net) return ODHS_E_NULL;
+    core_ensure(net);
     size_t nb = net->nbar, nk = net->ncon;
     const unsigned char *core = net->core;
     if (net->nperm) {
@@ -868,6 +823,7 @@ int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
 {
     if (!net) return ODHS_E_NULL;
     if (!flag) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    core_ensure(net);
     size_t nb = net->nbar, nk = net->ncon;
     if (net->nperm) {
         int st = odhs_network_constrained(net, &nb, &nk, NULL, NULL);
@@ -975,17 +931,14 @@ int odhs__net_add_wall(odhs_network *net, const odhs_wall *w)
     if (core) net->core = core;
     size_t *cdeg = odhs__realloc(net->cdeg, nn * sizeof *cdeg);
     if (cdeg) net->cdeg = cdeg;
-    unsigned char *mark = odhs__realloc(net->mark, nn);
-    if (mark) net->mark = mark;
     size_t *work = odhs__realloc(net->work, (2 * nn + 2) * sizeof *work);
     if (work) net->work = work;
-    if (!adj || !adjn || !adjcap || !core || !cdeg || !mark || !work) return ODHS_E_NOMEM;
+    if (!adj || !adjn || !adjcap || !core || !cdeg || !work) return ODHS_E_NOMEM;
     size_t node = nn - 1;
     adj[node] = NULL;
     adjn[node] = adjcap[node] = 0;
     core[node] = 1; /* a wall never leaves the constrained subset */
     cdeg[node] = 0;
-    mark[node] = 0;
     net->walls[net->nwalls++] = *w;
     net->free_modes = wall_free_modes(net);
     net->version++;

@@ -15,6 +15,12 @@
 
 #define EPS_F 1e-12 /* relative threshold for negative forces   */
 #define EPS_V 1e-12 /* relative threshold for approaching pairs */
+/* default drift-correction intervals: the paper's 10 steps with its Euler
+ * scheme (whose straight chords only open contact gaps, by O(dt^2)); every
+ * step with the adaptive scheme, whose chord errors (O(h^3), either sign)
+ * would otherwise leave overlaps of ~1e-11 at tol 1e-6 (docs/accuracy.md) */
+#define CORR_DEFAULT_EULER 10u
+#define CORR_DEFAULT_HEUN 1u
 
 static int sterr(const odhs_stepper *st, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
 static int sterr(const odhs_stepper *st, int status, const char *fmt, ...)
@@ -812,10 +818,10 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->n = sys->n;
     st->nd = sys->n * (size_t)sys->dim;
     st->dt = 1e-3;
-    st->integrator = ODHS_INTEGRATOR_EULER;
+    st->integrator = ODHS_INTEGRATOR_HEUN;
     st->tol = 1e-6;
     st->h = st->dt;
-    st->corr_every = 10;
+    st->corr_every = CORR_DEFAULT_HEUN;
     st->contact_tol = 1e-9;
     st->F = odhs__calloc(st->nd, sizeof(double));
     st->U = odhs__calloc(st->nd, sizeof(double));
@@ -828,9 +834,10 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     }
     st->U0 = odhs__calloc(st->nd, sizeof(double));
     st->Ua = odhs__calloc(st->nd, sizeof(double));
+    st->Up = odhs__calloc(st->nd, sizeof(double));
     st->disps = odhs__calloc(st->nd, sizeof(double));
     int s = odhs_network_create(sys, &st->net);
-    if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || !st->U0 || !st->Ua || !st->disps || s) {
+    if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || !st->U0 || !st->Ua || !st->Up || !st->disps || s) {
         odhs_stepper_destroy(st);
         return ODHS_E_NOMEM;
     }
@@ -842,7 +849,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
 {
     if (!st) return;
     odhs_network_destroy(st->net);
-    void *arrays[] = {st->disps, st->U0, st->Ua, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
+    void *arrays[] = {st->disps, st->U0, st->Ua, st->Up, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
                       st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->srest, st->ev, st->wsnap};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
@@ -867,6 +874,7 @@ int odhs_stepper_set_integrator(odhs_stepper *st, int integrator)
         return sterr(st, ODHS_E_INVALID, "unknown integrator %d", integrator);
     st->integrator = integrator;
     st->h = st->dt;
+    if (!st->corr_user) st->corr_every = integrator == ODHS_INTEGRATOR_HEUN ? CORR_DEFAULT_HEUN : CORR_DEFAULT_EULER;
     return ODHS_OK;
 }
 
@@ -876,6 +884,17 @@ int odhs_stepper_set_tolerance(odhs_stepper *st, double tol)
     if (!isfinite(tol) || !(tol > 0.0) || !(tol < 1.0))
         return sterr(st, ODHS_E_INVALID, "tolerance %g must be in (0, 1)", tol);
     st->tol = tol;
+    return ODHS_OK;
+}
+
+int odhs_stepper_get_settings(const odhs_stepper *st, int *integrator, double *dt, double *tol,
+                              unsigned *correction_interval)
+{
+    if (!st) return ODHS_E_NULL;
+    if (integrator) *integrator = st->integrator;
+    if (dt) *dt = st->dt;
+    if (tol) *tol = st->tol;
+    if (correction_interval) *correction_interval = st->corr_every;
     return ODHS_OK;
 }
 
@@ -891,6 +910,7 @@ int odhs_stepper_set_correction_interval(odhs_stepper *st, unsigned k)
 {
     if (!st) return ODHS_E_NULL;
     st->corr_every = k;
+    st->corr_user = 1;
     return ODHS_OK;
 }
 
@@ -1100,6 +1120,31 @@ static int restart_step(odhs_stepper *st)
 /* the smallest adaptive step: HEUN_HMIN dt, and never 0 (dt may be tiny) */
 static double heun_hmin(const odhs_stepper *st) { return fmax(HEUN_HMIN * st->dt, fmin(st->dt, DBL_MIN)); }
 
+/* Heun's step for dx/dt = G(t) x + U(x, t), k1 = G0 x0 + U0, predictor
+ * x* = x0 + tau k1, k2 = G* x* + U*:
+ *   x1 = x0 + tau/2 (k1 + k2) = x0 + tau Ga x0 + tau Ua with
+ *   Ga = (G0 + G*)/2 + tau/2 G* G0   (applied to positions and box alike)
+ *   Ua = (U0 + U*)/2 + tau/2 G* U0   (the flow advects the non-affine step).
+ * The G* G0 term matters under compression (G = -c I, G G = c^2 I): without it
+ * a touching pair's separation shrinks by (c tau)^2/2 per step; in simple
+ * shear G G = 0. Ua goes to st->Ua, from st->U0 and Us. */
+static void heun_chord(odhs_stepper *st, const double *G0, const double *Gs, const double *Us, double tau, double *Ga)
+{
+    int dim = st->dim;
+    for (size_t i = 0; i < st->n; ++i) {
+        double gu[3];
+        apply_G(Gs, dim, st->U0 + i * dim, gu);
+        for (int a = 0; a < dim; ++a)
+            st->Ua[i * dim + a] = 0.5 * (st->U0[i * dim + a] + Us[i * dim + a]) + 0.5 * tau * gu[a];
+    }
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+            double gg = 0.0;
+            for (int c = 0; c < 3; ++c) gg += Gs[3 * a + c] * G0[3 * c + b];
+            Ga[3 * a + b] = 0.5 * (G0[3 * a + b] + Gs[3 * a + b]) + 0.5 * tau * gg;
+        }
+}
+
 static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
 {
     odhs_system *sys = st->sys;
@@ -1110,6 +1155,7 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
     memcpy(G0, st->G, sizeof G0);
     memcpy(M0, st->M, sizeof M0);
     memcpy(st->U0, st->U, nd * sizeof *st->U0);
+    st->pred_ok = 0;
     double *disp0 = st->Ua; /* borrow: disp is restored from it below */
     for (int attempt = 0;; ++attempt) {
         double tau = st->h * st->tau, truncated = 0;
@@ -1131,8 +1177,8 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         double emax = 0.0;
         for (size_t i = 0; i < st->n && !s; ++i) {
             double e2 = 0.0, gu[3];
-            /* k2 - k1 = U* - U0 + tau G0 U0 (non-affine part) */
-            apply_G(G0, st->dim, st->U0 + i * st->dim, gu);
+            /* k2 - k1 = U* - U0 + tau G* U0 (non-affine part) */
+            apply_G(st->G, st->dim, st->U0 + i * st->dim, gu);
             for (int k = 0; k < st->dim; ++k) {
                 double dv = st->U[i * st->dim + k] - st->U0[i * st->dim + k] + tau * gu[k];
                 e2 += dv * dv;
@@ -1174,18 +1220,13 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         st->nsolves_pred++;
         double fac = err > 0.0 ? 0.9 * sqrt(st->tol / err) : 2.0;
         if (err <= st->tol || attempt >= 40) {
-            /* accepted: the chord of Heun's x1 = x0 + tau/2 (k1 + k2) with
-             * k = G x + U: non-affine velocity (U0 + U*)/2 plus the advection
-             * of the non-affine displacement by the flow, tau/2 G0 U0 (the
-             * G G x part is the frame: the box deforms with the same G) */
-            int dim = st->dim;
-            for (size_t i = 0; i < st->n; ++i) {
-                double gu[3];
-                apply_G(G0, dim, st->U0 + i * dim, gu);
-                for (int a = 0; a < dim; ++a)
-                    st->Ua[i * dim + a] = 0.5 * (st->U0[i * dim + a] + st->U[i * dim + a]) + 0.5 * tau * gu[a];
-            }
-            for (int a = 0; a < 9; ++a) Ga[a] = 0.5 * (G0[a] + Gs[a]);
+            /* accepted: the chord of Heun's x1 = x0 + tau/2 (k1 + k2) */
+            heun_chord(st, G0, Gs, st->U, tau, Ga);
+            /* kept for a shorter chord of this step (heun_shorter) */
+            memcpy(st->Up, st->U, nd * sizeof *st->Up);
+            memcpy(st->Gp, Gs, sizeof Gs);
+            st->taup = tau;
+            st->pred_ok = 1;
             memcpy(st->U, st->U0, nd * sizeof *st->U);
             if (!truncated) st->h = fmin(st->dt, fmax(st->h * fmin(2.0, fac), heun_hmin(st)));
             *tau_out = tau;
@@ -1194,6 +1235,21 @@ static int heun(odhs_stepper *st, double limit, double *Ga, double *tau_out)
         st->nrejected++;
         st->h = fmax(st->h * fmax(0.2, fac), heun_hmin(st));
     }
+}
+
+/* The Heun chord of [0, t] for t < taup, the accepted predictor's step, from
+ * U*(t) = U0 + (t/taup)(U*(taup) - U0) (and G likewise) instead of a new
+ * predictor solve. U*(t) is off by O(t taup), the chord by O(t^2 taup): the
+ * order of Heun's own local error, so the step stays second order. Used when
+ * a step is cut short at a collision or an opening inside it. */
+static void heun_shorter(odhs_stepper *st, double t, double *Ga)
+{
+    double w = t / st->taup, G0[9], Gt[9];
+    memcpy(G0, st->G, sizeof G0);
+    for (int a = 0; a < 9; ++a) Gt[a] = G0[a] + w * (st->Gp[a] - G0[a]);
+    /* U*(t) into st->tmp (free during the step) */
+    for (size_t k = 0; k < st->nd; ++k) st->tmp[k] = st->U0[k] + w * (st->Up[k] - st->U0[k]);
+    heun_chord(st, G0, Gt, st->tmp, t, Ga);
 }
 
 /* ---- one step ----------------------------------------------------------------- */
@@ -1236,6 +1292,7 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
         }
     }
     int relocated = 0, nhalve = 0;
+    st->pred_ok = 0;
     if (st->integrator == ODHS_INTEGRATOR_HEUN) {
         memcpy(st->disps, st->disp, st->nd * sizeof *st->disps);
         memcpy(st->Ms, st->M, sizeof st->Ms);
@@ -1251,7 +1308,12 @@ again:;
     const double *vel = st->U;
     memcpy(G, st->G, sizeof G);
     if (st->integrator == ODHS_INTEGRATOR_HEUN) {
-        if ((s = heun(st, limit, G, &tplan))) goto fail;
+        if (relocated && st->pred_ok && limit < st->taup) {
+            heun_shorter(st, limit, G);
+            tplan = limit;
+        } else if ((s = heun(st, limit, G, &tplan))) {
+            goto fail;
+        }
         vel = st->Ua;
     }
 
@@ -1351,12 +1413,14 @@ again:;
         odhs__prop_switch(st->drv, st->time, st->lambda);
         if ((s = eval_forces(st))) goto fail;
     }
-    if ((s = rewire(st))) goto fail;
-    if (!st->jammed && st->corr_every && st->nsteps % st->corr_every == 0) {
+    if (st->corr_every && st->nsteps % st->corr_every == 0) {
+        /* drift correction before the rewiring: the rewiring's solve is then
+         * that of the corrected geometry, and contacts the correction adds
+         * (collisions on its path) are rewired with the step's events */
         int added = 0;
         if ((s = correct(st, &added))) goto fail;
-        if ((s = rewire(st))) goto fail;
     }
+    if ((s = rewire(st))) goto fail;
     if ((s = emit_events(st, first, stop))) goto fail;
     if (st->jammed)
         return sterr(st, ODHS_JAMMED, "jammed at t = %.17g: isostatic constrained subset, positive self-stress",

@@ -197,12 +197,103 @@ START_TEST(test_heun_two_discs)
 }
 END_TEST
 
+/* Two touching discs under isotropic compression (G = -c I): the exact motion
+ * keeps them touching, the non-affine velocities cancelling the affine
+ * approach. Heun's chord has the G* G0 term (c^2 tau^2 / 2 per step); without
+ * it the pair would overlap by (c tau)^2 / 2 of its distance per step
+ * (5e-5 here). No drift correction, large steps. Also with shear added (the
+ * pair rotates: measured 9e-16, bound 1e-12). */
+START_TEST(test_heun_compressed_pair)
+{
+    for (int sheared = 0; sheared <= 1; ++sheared) {
+        odhs_system *sys;
+        odhs_solver *sol;
+        odhs_driver *drv;
+        odhs_stepper *st;
+        double L[2] = {10, 10}, r[2] = {0.5, 0.5}, x[4] = {4.5, 5.0, 5.5, 5.0};
+        ck_assert_int_eq(odhs_system_create(2, 2, &sys), ODHS_OK);
+        ck_assert_int_eq(odhs_system_set_configuration(sys, L, 0.0, r, x), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_set_compression_rate(drv, 1.0), ODHS_OK);
+        if (sheared) ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 1.0), ODHS_OK);
+        ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_HEUN), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_dt(st, 1e-2), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_tolerance(st, 1e-3), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_correction_interval(st, 0), ODHS_OK);
+        double worst = 0.0;
+        for (int k = 0; k < 40; ++k) {
+            odhs_event ev;
+            ck_assert_int_eq(odhs_stepper_step(st, &ev), ODHS_OK);
+            double gap, ov;
+            ck_assert_int_eq(odhs_stepper_errors(st, &gap, &ov), ODHS_OK);
+            ck_assert_uint_eq(odhs_network_count(odhs_stepper_network(st)), 1);
+            worst = fmax(worst, gap);
+        }
+        double t;
+        ck_assert_int_eq(odhs_stepper_time(st, &t), ODHS_OK);
+        fprintf(stderr, "[adaptive] touching pair, compression%s: worst contact gap %.2e over t = %.2f\n",
+                sheared ? " + shear" : "", worst, t);
+        ck_assert_msg(worst <= (sheared ? 1e-12 : 1e-13), "contact gap %.3g (compression%s)", worst,
+                      sheared ? " + shear" : "");
+        odhs_stepper_destroy(st);
+        odhs_driver_destroy(drv);
+        odhs_solver_destroy(sol);
+        odhs_system_destroy(sys);
+    }
+}
+END_TEST
+
+/* the default settings: adaptive Heun, tol 1e-6, dt 1e-3, correction every
+ * step; the paper's Euler brings its interval 10 unless one was set */
+START_TEST(test_default_settings)
+{
+    odhs_system *sys;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    double L[2] = {10, 10}, r[2] = {0.5, 0.5}, x[4] = {3.0, 5.0, 6.0, 5.0};
+    ck_assert_int_eq(odhs_system_create(2, 2, &sys), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_configuration(sys, L, 0.0, r, x), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+    int integ = -1;
+    double dt = 0, tol = 0;
+    unsigned k = 99;
+    ck_assert_int_eq(odhs_stepper_get_settings(st, &integ, &dt, &tol, &k), ODHS_OK);
+    ck_assert_int_eq(integ, ODHS_INTEGRATOR_HEUN);
+    ck_assert(dt == 1e-3 && tol == 1e-6);
+    ck_assert_uint_eq(k, 1);
+    ck_assert_int_eq(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_get_settings(st, &integ, NULL, NULL, &k), ODHS_OK);
+    ck_assert_int_eq(integ, ODHS_INTEGRATOR_EULER);
+    ck_assert_uint_eq(k, 10);
+    ck_assert_int_eq(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_HEUN), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_get_settings(st, NULL, NULL, NULL, &k), ODHS_OK);
+    ck_assert_uint_eq(k, 1);
+    /* an interval set by the user stays */
+    ck_assert_int_eq(odhs_stepper_set_correction_interval(st, 5), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_get_settings(st, NULL, NULL, NULL, &k), ODHS_OK);
+    ck_assert_uint_eq(k, 5);
+    ck_assert_int_eq(odhs_stepper_get_settings(NULL, &integ, NULL, NULL, NULL), ODHS_E_NULL);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(sys);
+}
+END_TEST
+
 Suite *make_adaptive_suite(void)
 {
     Suite *s = suite_create("adaptive");
     TCase *tc = tcase_create("heun");
     tcase_set_timeout(tc, 300);
     tcase_add_test(tc, test_heun_two_discs);
+    tcase_add_test(tc, test_heun_compressed_pair);
+    tcase_add_test(tc, test_default_settings);
     tcase_add_test(tc, test_heun_invariants_and_convergence);
     suite_add_tcase(s, tc);
     return s;

@@ -1787,6 +1787,10 @@ static int huge_rate_case(void)
       double t = -1; int rc = odhs_stepper_time(w->st, &t); return rc == ODHS_OK && t != 0.0 ? post("t = %g", t) : rc;) \
     X(st_z_before_step, odhs_stepper_coordination, ODHS_OK, NOALT, H_NONE, 0,                                  \
       double z = -1; int rc = odhs_stepper_coordination(w->st, &z); return rc == ODHS_OK && z != 0.0 ? post("z = %g", z) : rc;) \
+    X(st_settings_null, odhs_stepper_get_settings, ODHS_E_NULL, NOALT, H_NONE, 0,                              \
+      int i; double a; unsigned k; return odhs_stepper_get_settings(NULL, &i, &a, &a, &k);)                    \
+    X(st_settings_all_null, odhs_stepper_get_settings, ODHS_OK, NOALT, H_NONE, 0,                              \
+      return odhs_stepper_get_settings(w->st, NULL, NULL, NULL, NULL);)                                        \
     X(st_adaptive_null, odhs_stepper_adaptive_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                            \
       uint64_t r; double h; return odhs_stepper_adaptive_stats(NULL, &r, &h);)                                 \
     X(st_adaptive_all_null, odhs_stepper_adaptive_stats, ODHS_OK, NOALT, H_NONE, 0,                            \

@@ -145,6 +145,10 @@ static void scene_init(scene *s, odhs_system *sys, const char *solver)
     CHECK_OK(odhs_driver_create(&s->drv));
     CHECK_OK(odhs_solver_create_by_name(solver, &s->sol));
     CHECK_OK(odhs_stepper_create(sys, s->drv, s->sol, &s->st));
+    /* this suite checks the paper's scheme (explicit Euler, fixed step dt,
+     * correction every 10 steps) step by step; the adaptive default has its
+     * own suite (check_adaptive.c) */
+    CHECK_OK(odhs_stepper_set_integrator(s->st, ODHS_INTEGRATOR_EULER));
     s->x = xcalloc(s->nd, sizeof(double));
     s->U = xcalloc(s->nd, sizeof(double));
     s->r = xcalloc(s->n, sizeof(double));

@@ -26,7 +26,7 @@ extern "C" {
 
 /* ---- version ------------------------------------------------------------ */
 #define ODHS_VERSION_MAJOR 0
-#define ODHS_VERSION_MINOR 1
+#define ODHS_VERSION_MINOR 2
 #define ODHS_VERSION_PATCH 0
 /* MAJOR*10000 + MINOR*100 + PATCH */
 #define ODHS_VERSION_NUMBER \

@@ -82,15 +82,22 @@ enum {
     ODHS_INTEGRATOR_HEUN = 1
 };
 
-/** Step size in units of tau (default 1e-3); the largest step with
- *  ODHS_INTEGRATOR_HEUN. */
+/** Step size in units of tau (default 1e-3): the fixed step of
+ *  ODHS_INTEGRATOR_EULER, the largest step of ODHS_INTEGRATOR_HEUN. */
 ODHS_API int odhs_stepper_set_dt(odhs_stepper *st, double dt);
-/** Choose the integrator (default ODHS_INTEGRATOR_EULER). */
+/** Choose the integrator (default ODHS_INTEGRATOR_HEUN, with tolerance 1e-6
+ *  and drift correction after every step). The paper's scheme is the named mode
+ *  ODHS_INTEGRATOR_EULER (with the "cg" solver for the paper's solver): it
+ *  brings the paper's correction interval, 10, unless an interval was set
+ *  with odhs_stepper_set_correction_interval, which is then kept. (Before
+ *  version 0.2 the default was ODHS_INTEGRATOR_EULER.) */
 ODHS_API int odhs_stepper_set_integrator(odhs_stepper *st, int integrator);
 /** Error tolerance of the adaptive integrator (relative to the mean diameter,
  *  per step; default 1e-6; in (0, 1)). */
 ODHS_API int odhs_stepper_set_tolerance(odhs_stepper *st, double tol);
-/** Drift correction every k steps (default 10; 0 disables). */
+/** Drift correction every k steps (0 disables). Default: 1 with
+ *  ODHS_INTEGRATOR_HEUN, 10 (the paper's) with ODHS_INTEGRATOR_EULER; once
+ *  set here, the interval no longer follows the integrator. */
 ODHS_API int odhs_stepper_set_correction_interval(odhs_stepper *st, unsigned k);
 /** Relative gap (gap / (a_i + a_j)) below which pairs count as initial contacts
  *  when the stepper starts (default 1e-9). */
@@ -172,6 +179,11 @@ ODHS_API int odhs_stepper_run_until_packing_fraction(odhs_stepper *st, double ph
  * once (zero before the first step). */
 ODHS_API int odhs_stepper_time(const odhs_stepper *st, double *t);
 ODHS_API int odhs_stepper_strain(const odhs_stepper *st, double *gamma);
+/** The integration settings in force: integrator, dt, adaptive tolerance
+ *  and drift-correction interval (any output may be NULL). A new stepper
+ *  reports ODHS_INTEGRATOR_HEUN, 1e-3, 1e-6, 1. (Since 0.2.) */
+ODHS_API int odhs_stepper_get_settings(const odhs_stepper *st, int *integrator, double *dt, double *tol,
+                                       unsigned *correction_interval);
 /** Adaptive-integrator counters: rejected steps and the current step (in tau
  *  units); either may be NULL. */
 ODHS_API int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejected, double *h);
