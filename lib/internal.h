@@ -295,6 +295,8 @@ struct odhs_solver {
  * odhs__solver_invalidate when it may have been replaced); reuse = 0: set up
  * whenever the backend has a setup. */
 int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse);
+/* the same with a relative residual of rtol where the backend has a "tol" */
+int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const double *b, double *x, double rtol);
 void odhs__solver_invalidate(odhs_solver *s);
 int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, const double *f0);
 int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);

@@ -1021,7 +1021,11 @@ static int correct(odhs_stepper *st, int *added)
         if (isostatic) return ODHS_OK; /* N singular: the rewiring handles it (f0) */
         prev = gmax;
         memset(st->cx, 0, nc * sizeof *st->cx);
-        if ((s = solve(st, net->gap, st->cx))) {
+        /* the gaps are small: a relative residual of 1e-7 removes them to
+         * round-off in one pass (a further pass follows if not) */
+        s = odhs__solver_solve_relaxed(st->sol, net, net->gap, st->cx, 1e-7);
+        if (s) s = sterr(st, s, "force solve: %s", odhs_solver_errmsg(st->sol));
+        if (s) {
             /* a (nearly) redundant contact makes N singular for this
              * right-hand side: the correction waits for the next interval */
             if (s == ODHS_E_SINGULAR || s == ODHS_E_NOCONV) {

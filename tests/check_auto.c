@@ -209,6 +209,12 @@ START_TEST(test_params)
     CK_OK(odhs_solver_set_param(a, "lsq_dense_max", 0.0));
     CK_OK(odhs_solver_set_param(a, "check_tol", 1e-8));
     double v;
+    /* "tol": the iterative backends' residual, their default 1e-12 until set */
+    ck_assert_double_eq(au_stat(a, "tol"), 1e-12);
+    CK_OK(odhs_solver_set_param(a, "tol", 1e-9));
+    ck_assert_double_eq(au_stat(a, "tol"), 1e-9);
+    ck_assert_int_eq(odhs_solver_set_param(a, "tol", 1.0), ODHS_E_INVALID);
+    ck_assert_double_eq(au_stat(a, "tol"), 1e-9);
     ck_assert_int_eq(odhs_solver_get_stat(a, "no-such-stat", &v), ODHS_E_INVALID);
     ck_assert_double_eq(au_stat(a, "fallbacks"), 0.0);
     ck_assert_double_eq(au_stat(a, "last_failure"), 0.0);
@@ -307,6 +313,11 @@ START_TEST(test_stepper_shear)
         }
         smax = fmax(smax, fabs(s[1]));
         worst = fmax(worst, fabs(s[0] - s[1]));
+        /* default settings: the drift correction after every step (its solve
+         * at a relaxed residual) leaves the contact gaps at round-off */
+        double gap, ov;
+        CK_OK(odhs_stepper_errors(st[0], &gap, &ov));
+        ck_assert_msg(gap <= 1e-13 && ov <= 1e-13, "step %ld: contact gap %.3g, overlap %.3g", steps, gap, ov);
         steps++;
     }
     ck_assert(smax > 0.0);

@@ -125,7 +125,9 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
  *  wrappers (result check, iterative refinement); their check tolerance is
  *  the parameter "check_tol" (default 1e-6). "suitesparse" = 0 makes a
  *  SuiteSparse build choose as a build without it (1 in a build without
- *  gives ODHS_E_NOTINSTALLED). Statistics: "backend" and "primary" (codes
+ *  gives ODHS_E_NOTINSTALLED). "tol" (since 0.2) is handed to the iterative
+ *  backends cg and cholmod-pcg (their relative residual; default theirs,
+ *  1e-12). Statistics: "backend" and "primary" (codes
  *  0 cg, 1 dense, 2 cholmod, 3 cholmod-pcg, 4 spqr, 5 lsq-svd, 6 lsq-cg; -1
  *  before the first solve), "fallbacks" (failed attempts followed by another
  *  backend), "fallback_solves" (solves not answered by the primary),

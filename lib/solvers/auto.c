@@ -65,6 +65,7 @@ typedef struct {
     int have_ss;          /* SuiteSparse backends usable (build and "suitesparse") */
     /* parameters */
     double dense_max, dense_fallback_max, lsq_dense_max, lsq_rcond, check_tol;
+    double tol;           /* "tol" of the iterative backends (cg, cholmod-pcg); 0: their own */
     int prefer, retry_after;
     /* state */
     int sticky_backend;   /* backend to try first, -1: none */
@@ -126,6 +127,10 @@ static int auto_set_param(void *state, const char *key, double v)
         for (int k = 0; k < NHANDLES; ++k)
             if (s->h[k]) odhs_solver_set_check_tolerance(s->h[k], v);
         if (s->lsqcg) odhs_solver_set_check_tolerance(s->lsqcg, v);
+    } else if (!strcmp(key, "tol") && v > 0.0 && v < 1.0) {
+        s->tol = v;
+        for (int k = 0; k < NHANDLES; ++k)
+            if (s->h[k] && (k == B_CG || k == B_CHOLMOD_PCG)) odhs_solver_set_param(s->h[k], "tol", v);
     } else if (!strcmp(key, "prefer") && (v == 0.0 || v == 1.0)) s->prefer = (int)v;
     else if (!strcmp(key, "retry_after") && v >= 0.0 && v <= 1e9) {
         s->retry_after = (int)v;
@@ -164,6 +169,7 @@ static int handle(auto_state *s, int b, odhs_solver **out)
         int st = odhs_solver_create(t, &s->h[b]);
         if (st) return st;
         odhs_solver_set_check_tolerance(s->h[b], s->check_tol);
+        if (s->tol > 0.0 && (b == B_CG || b == B_CHOLMOD_PCG)) odhs_solver_set_param(s->h[b], "tol", s->tol);
     }
     *out = s->h[b];
     return ODHS_OK;
@@ -370,6 +376,7 @@ static int auto_get_stat(void *state, const char *key, double *v)
     else if (!strcmp(key, "primary")) *v = s->primary;
     else if (!strcmp(key, "last_failure")) *v = s->last_failure;
     else if (!strcmp(key, "suitesparse")) *v = s->have_ss;
+    else if (!strcmp(key, "tol")) *v = s->tol > 0.0 ? s->tol : 1e-12; /* the iterative backends' default */
     else if (s->last == B_LSQ_SVD || s->last == B_LSQ_CG) {
         if (!strcmp(key, "rank")) *v = s->last_rank;
         else if (s->last == B_LSQ_CG) return odhs_solver_get_stat(s->lsqcg, key, v);
