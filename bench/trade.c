@@ -20,6 +20,9 @@
  *
  * usage: trade [N] [GAMMA] [SOLVER] [CSV] [SVG]   (defaults 1000, 0.01, cg,
  *        no CSV, trade.svg: rms position error against CPU time)
+ *        trade --plot CSV SVG [N] [GAMMA] [SOLVER]   the plot again from a CSV
+ * environment: ODHS_TRADE_PAPER_1E7=1 adds paper mode at dt 1e-7 (~10 CPU
+ *        minutes at N = 1000)
  */
 #define _DEFAULT_SOURCE
 #define _POSIX_C_SOURCE 200809L
@@ -127,8 +130,94 @@ static int run(const odhs_system *start, const char *solver, const setting *s, d
     return r->rc;
 }
 
+/* the main plot: rms position error against CPU time, one family per kind
+ * of setting (from its label); settings with the same error as the previous
+ * one of their family share its label */
+static void trade_plot(const char *svg, size_t n, double gamma, const char *solver, const char *const *lab,
+                       const double *cpu, const double *rms, size_t m, const char *note)
+{
+    pl_plot pp;
+    char title[160];
+    snprintf(title, sizeof title, "Speed/accuracy trade, N = %zu, 2D, phi = 0.80, strain %g", n, gamma);
+    pl_init(&pp, title, "CPU seconds", "rms position error (mean diameters)", 1, 1);
+    int fam[4];
+    char hl[64];
+    fam[0] = pl_series_add(&pp, "paper: euler, cg, corr 10", 1, 0, 2);
+    fam[1] = pl_series_add(&pp, "euler dt 1e-5, other corr", 3, 1, 3);
+    snprintf(hl, sizeof hl, "heun (adaptive), %s, corr 10", solver);
+    fam[2] = pl_series_add(&pp, hl, 0, 0, 1);
+    fam[3] = pl_series_add(&pp, "heun, corr 1 or 100", 2, 1, 4);
+    int famd = pl_series_add(&pp, "defaults: heun tol 1e-6, corr 1", 4, 0, 5);
+    pp.s[famd].lines = 0;
+    pp.s[fam[1]].lines = 0;
+    pp.s[fam[3]].lines = 0;
+    double last_rms[4] = {-1, -1, -1, -1};
+    for (size_t k = 0; k < m; ++k) {
+        const char *l = lab[k];
+        if (!strcmp(l, "default settings")) {
+            pl_point(&pp, famd, cpu[k], rms[k]); /* in the legend: no label over the heun points */
+            continue;
+        }
+        int f = !strncmp(l, "paper", 5) ? 0 : !strncmp(l, "euler", 5) ? 1 : strstr(l, "corr") ? 3 : 2;
+        char text[24] = "";
+        /* "dt X", "corr K" or "tol X" from the label; the few "heun, other
+         * corr" points are named in the legend (labels would overlap) */
+        const char *v = f == 0 ? strstr(l, "dt ") : f == 1 ? strstr(l, "corr ") : f == 2 ? strstr(l, "tol ") : NULL;
+        if (v) {
+            size_t key = strcspn(v, " ") + 1;
+            snprintf(text, sizeof text, "%.*s", (int)(key + strcspn(v + key, " ")), v);
+        }
+        if (last_rms[f] > 0 && fabs(rms[k] - last_rms[f]) <= 1e-3 * rms[k]) text[0] = 0; /* same point */
+        last_rms[f] = rms[k];
+        pl_point_label(&pp, fam[f], cpu[k], rms[k], text);
+    }
+    pl_note(&pp, note);
+    if (pl_write_svg(&pp, svg)) fprintf(stderr, "trade: cannot write %s\n", svg);
+    else printf("# plot: %s\n", svg);
+    pl_free(&pp);
+}
+
+/* trade --plot CSV SVG [N] [GAMMA] [SOLVER]: the plot again from a CSV of a run */
+static int replot(int argc, char **argv)
+{
+    if (argc < 4) {
+        fprintf(stderr, "usage: trade --plot CSV SVG [N] [GAMMA] [SOLVER]\n");
+        return 2;
+    }
+    FILE *f = fopen(argv[2], "r");
+    if (!f) {
+        fprintf(stderr, "trade: cannot read %s\n", argv[2]);
+        return 1;
+    }
+    static char labs[32][64];
+    const char *lp[32];
+    double cpu[32], rms[32];
+    size_t m = 0;
+    char line[512];
+    while (m < 32 && fgets(line, sizeof line, f)) {
+        char *c1 = strchr(line, ',');
+        if (!c1 || !strncmp(line, "setting,", 8)) continue;
+        *c1 = 0;
+        double wall, c, st, ev, rej, r;
+        if (sscanf(c1 + 1, "%lf,%lf,%lf,%lf,%lf,%lf", &wall, &c, &st, &ev, &rej, &r) != 6) continue;
+        snprintf(labs[m], sizeof labs[m], "%.63s", line);
+        lp[m] = labs[m];
+        cpu[m] = c;
+        rms[m++] = r;
+    }
+    fclose(f);
+    size_t n = argc > 4 ? (size_t)atol(argv[4]) : 1000;
+    double gamma = argc > 5 ? atof(argv[5]) : 0.01;
+    char model[256], note[400];
+    cpu_model(model, sizeof model);
+    snprintf(note, sizeof note, "%.120s; replotted from %.200s (times: see the run's output)", model, argv[2]);
+    trade_plot(argv[3], n, gamma, argc > 6 ? argv[6] : "auto", lp, cpu, rms, m, note);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "--plot")) return replot(argc, argv);
     size_t n = argc > 1 ? (size_t)atol(argv[1]) : 1000;
     double gamma = argc > 2 ? atof(argv[2]) : 0.01;
     const char *solver = argc > 3 ? argv[3] : "cg";
@@ -330,41 +419,20 @@ int main(int argc, char **argv)
         }
     }
     /* plot: rms position error against CPU time */
-    pl_plot pp;
-    char title[160];
-    snprintf(title, sizeof title, "Speed/accuracy trade, N = %zu, 2D, phi = 0.80, strain %g", n, gamma);
-    pl_init(&pp, title, "CPU seconds", "rms position error (mean diameters)", 1, 1);
-    int fam[4];
-    fam[0] = pl_series_add(&pp, "paper: euler, cg, corr 10", 1, 0, 2);
-    fam[1] = pl_series_add(&pp, "euler dt 1e-5, other corr", 3, 1, 3);
-    char hl[64];
-    snprintf(hl, sizeof hl, "heun (adaptive), %s, corr 10", solver);
-    fam[2] = pl_series_add(&pp, hl, 0, 0, 1);
-    fam[3] = pl_series_add(&pp, "heun tol 1e-8, corr 100", 2, 1, 4);
-    int famd = pl_series_add(&pp, "default settings", 4, 0, 5);
-    pp.s[famd].lines = 0;
-    pp.s[fam[1]].lines = 0;
-    pp.s[fam[3]].lines = 0;
-    for (size_t k = 0; k < nset; ++k) {
-        if (keep[k].rc) continue;
-        const char *l = set[k].label;
-        if (set[k].defaults) {
-            pl_point_label(&pp, famd, keep[k].cpu, keep[k].rms, "defaults");
-            continue;
+    {
+        const char *labs[32];
+        double cpus[32], rmss[32];
+        size_t m = 0;
+        for (size_t k = 0; k < nset; ++k) {
+            if (keep[k].rc) continue;
+            labs[m] = set[k].label;
+            cpus[m] = keep[k].cpu;
+            rmss[m++] = keep[k].rms;
         }
-        int f = !strncmp(l, "paper", 5) ? 0 : !strncmp(l, "euler", 5) ? 1 : strstr(l, "corr") ? 3 : 2;
-        char lab[24];
-        if (f == 0) snprintf(lab, sizeof lab, "dt %.0e", set[k].dt);
-        else if (f == 1) snprintf(lab, sizeof lab, "corr %u", set[k].corr);
-        else snprintf(lab, sizeof lab, "tol %.0e", set[k].tol);
-        pl_point_label(&pp, fam[f], keep[k].cpu, keep[k].rms, lab);
+        char note[300];
+        snprintf(note, sizeof note, "%.120s; shared machine (load %.1f); reference heun tol 1e-11, corr 1", cpu, la[0]);
+        trade_plot(svg, n, gamma, solver, labs, cpus, rmss, m, note);
     }
-    char note[300];
-    snprintf(note, sizeof note, "%.120s; shared machine (load %.1f); reference heun tol 1e-11, corr 1", cpu, la[0]);
-    pl_note(&pp, note);
-    if (pl_write_svg(&pp, svg)) fprintf(stderr, "trade: cannot write %s\n", svg);
-    else printf("# plot: %s\n", svg);
-    pl_free(&pp);
     if (csv) fclose(csv);
     free(R.x);
     free(rad);

@@ -155,6 +155,33 @@ START_TEST(test_heun_invariants_and_convergence)
 }
 END_TEST
 
+/* two discs of radius 0.5 in a 10 x 10 box at x (4 numbers), a driver, a
+ * dense solver and a stepper with the library's default settings */
+typedef struct {
+    odhs_system *sys;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st;
+} pair_scene;
+
+static void pair_new(pair_scene *p, const double *x)
+{
+    double L[2] = {10, 10}, r[2] = {0.5, 0.5};
+    ck_assert_int_eq(odhs_system_create(2, 2, &p->sys), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_configuration(p->sys, L, 0.0, r, x), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&p->drv), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &p->sol), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(p->sys, p->drv, p->sol, &p->st), ODHS_OK);
+}
+
+static void pair_free(pair_scene *p)
+{
+    odhs_stepper_destroy(p->st);
+    odhs_driver_destroy(p->drv);
+    odhs_solver_destroy(p->sol);
+    odhs_system_destroy(p->sys);
+}
+
 START_TEST(test_heun_two_discs)
 {
     /* oblique push: the contact forms at the analytic time, exactly as with
@@ -206,18 +233,12 @@ END_TEST
 START_TEST(test_heun_compressed_pair)
 {
     for (int sheared = 0; sheared <= 1; ++sheared) {
-        odhs_system *sys;
-        odhs_solver *sol;
-        odhs_driver *drv;
-        odhs_stepper *st;
-        double L[2] = {10, 10}, r[2] = {0.5, 0.5}, x[4] = {4.5, 5.0, 5.5, 5.0};
-        ck_assert_int_eq(odhs_system_create(2, 2, &sys), ODHS_OK);
-        ck_assert_int_eq(odhs_system_set_configuration(sys, L, 0.0, r, x), ODHS_OK);
-        ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
-        ck_assert_int_eq(odhs_driver_set_compression_rate(drv, 1.0), ODHS_OK);
-        if (sheared) ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 1.0), ODHS_OK);
-        ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
-        ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+        const double x[4] = {4.5, 5.0, 5.5, 5.0};
+        pair_scene p;
+        pair_new(&p, x);
+        odhs_stepper *st = p.st;
+        ck_assert_int_eq(odhs_driver_set_compression_rate(p.drv, 1.0), ODHS_OK);
+        if (sheared) ck_assert_int_eq(odhs_driver_set_shear_rate(p.drv, 1.0), ODHS_OK);
         ck_assert_int_eq(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_HEUN), ODHS_OK);
         ck_assert_int_eq(odhs_stepper_set_dt(st, 1e-2), ODHS_OK);
         ck_assert_int_eq(odhs_stepper_set_tolerance(st, 1e-3), ODHS_OK);
@@ -237,10 +258,7 @@ START_TEST(test_heun_compressed_pair)
                 sheared ? " + shear" : "", worst, t);
         ck_assert_msg(worst <= (sheared ? 1e-12 : 1e-13), "contact gap %.3g (compression%s)", worst,
                       sheared ? " + shear" : "");
-        odhs_stepper_destroy(st);
-        odhs_driver_destroy(drv);
-        odhs_solver_destroy(sol);
-        odhs_system_destroy(sys);
+        pair_free(&p);
     }
 }
 END_TEST
@@ -249,16 +267,10 @@ END_TEST
  * step; the paper's Euler brings its interval 10 unless one was set */
 START_TEST(test_default_settings)
 {
-    odhs_system *sys;
-    odhs_solver *sol;
-    odhs_driver *drv;
-    odhs_stepper *st;
-    double L[2] = {10, 10}, r[2] = {0.5, 0.5}, x[4] = {3.0, 5.0, 6.0, 5.0};
-    ck_assert_int_eq(odhs_system_create(2, 2, &sys), ODHS_OK);
-    ck_assert_int_eq(odhs_system_set_configuration(sys, L, 0.0, r, x), ODHS_OK);
-    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
-    ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
-    ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+    const double x[4] = {3.0, 5.0, 6.0, 5.0};
+    pair_scene p;
+    pair_new(&p, x);
+    odhs_stepper *st = p.st;
     int integ = -1;
     double dt = 0, tol = 0;
     unsigned k = 99;
@@ -279,10 +291,7 @@ START_TEST(test_default_settings)
     ck_assert_int_eq(odhs_stepper_get_settings(st, NULL, NULL, NULL, &k), ODHS_OK);
     ck_assert_uint_eq(k, 5);
     ck_assert_int_eq(odhs_stepper_get_settings(NULL, &integ, NULL, NULL, NULL), ODHS_E_NULL);
-    odhs_stepper_destroy(st);
-    odhs_driver_destroy(drv);
-    odhs_solver_destroy(sol);
-    odhs_system_destroy(sys);
+    pair_free(&p);
 }
 END_TEST
 
