@@ -860,7 +860,7 @@ static void shear_final(af_fix *f, const af_scenario *sc)
 
 /* -- jam: compression to jamming with the self-stress f0 (dense), then the
  *    certificate, f0 again and the contacts file ---------------------------- */
-enum { JAM_RESET = 6, JAM_STEPS = 7 };
+enum { JAM_RESET = 7, JAM_STEPS = 8 };
 static int jam_steps; /* steps to jamming from cfg_prejam (probe) */
 
 static int jam_op(af_fix *f, const af_scenario *sc, int k)
@@ -874,6 +874,10 @@ static int jam_op(af_fix *f, const af_scenario *sc, int k)
     case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
     case 4: return odhs_stepper_set_dt(f->st, 0.01);
     case 5: return odhs_stepper_set_contact_tolerance(f->st, 1e-6);
+    /* the paper's Euler scheme at dt = 0.01 jams in some 15 steps; the
+     * default adaptive scheme takes ~2000 (the Heun allocations are walked
+     * by shear_heun_dense) */
+    case 6: return odhs_stepper_set_integrator(f->st, ODHS_INTEGRATOR_EULER);
     case JAM_RESET: return odhs_stepper_reset(f->st);
     }
     k -= JAM_STEPS + jam_steps;
