@@ -30,8 +30,11 @@ static void usage(FILE *f)
             "  --seed S           built-in scene: random seed (default 1)\n"
             "  --solver NAME      linear solver (default cholmod-pcg when built with\n"
             "                     SuiteSparse, else dense up to N = 2000 and cg above)\n"
-            "  --dt X             step of the paper's explicit Euler scheme, which this\n"
-            "                     program uses, in natural units (default 1e-3)\n"
+            "  --integrator I     heun (adaptive, the library's default) or euler (the\n"
+            "                     paper's fixed step) (default heun)\n"
+            "  --tol X            heun: local error tolerance (default 1e-6)\n"
+            "  --dt X             euler: the step; heun: the largest step, in natural\n"
+            "                     units (default 1e-3)\n"
             "  --max-strain X     shear protocols: give up after this strain (default 20)\n"
             "  --correction K     drift correction every K steps (default 1: certified\n"
             "                     packings need contact gaps at round-off when they jam)\n"
@@ -43,6 +46,16 @@ static void usage(FILE *f)
             "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed\n"
             "or not certified (force balance < 1e-12, gaps < 1e-13, no overlap, all\n"
             "backbone forces > 0, isostatic).\n");
+}
+
+/* the integration settings of the options */
+static int configure(odhs_stepper *st, int integrator, double dt, double tol, unsigned long corr)
+{
+    int rc = odhs_stepper_set_integrator(st, integrator);
+    if (!rc) rc = odhs_stepper_set_dt(st, dt);
+    if (!rc && integrator == ODHS_INTEGRATOR_HEUN) rc = odhs_stepper_set_tolerance(st, tol);
+    if (!rc) rc = odhs_stepper_set_correction_interval(st, (unsigned)corr);
+    return rc;
 }
 
 /* drive with the given driver until jammed (or failure / strain budget) */
@@ -69,7 +82,8 @@ int main(int argc, char **argv)
 {
     const char *protocol = "compress", *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL,
                *solver_name = NULL;
-    double dt = 1e-3, max_strain = 20.0;
+    double dt = 1e-3, max_strain = 20.0, tol = 1e-6;
+    int integrator = ODHS_INTEGRATOR_HEUN;
     unsigned long corr = 1;
     unsigned long n = 256, seed = 1, dim = 2;
     for (int a = 1; a < argc; ++a) {
@@ -94,6 +108,10 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--contacts")) contacts = v;
         else if (!strcmp(o, "--svg")) svg = v;
         else if (!strcmp(o, "--solver")) solver_name = v;
+        else if (!strcmp(o, "--integrator")) {
+            integrator = !strcmp(v, "heun") ? ODHS_INTEGRATOR_HEUN : ODHS_INTEGRATOR_EULER;
+            bad = strcmp(v, "heun") && strcmp(v, "euler");
+        } else if (!strcmp(o, "--tol")) bad = cli_double(v, &tol) || !(tol > 0 && tol < 1);
         else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
         else if (!strcmp(o, "--max-strain")) bad = cli_double(v, &max_strain) || max_strain <= 0;
         else if (!strcmp(o, "--correction")) bad = cli_ulong(v, &corr) || corr > 1000000;
@@ -134,13 +152,12 @@ int main(int argc, char **argv)
     odhs_driver *drv;
     odhs_stepper *st;
     if (odhs_driver_create(&drv) || odhs_stepper_create(sys, drv, solver, &st) ||
-        odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER) || odhs_stepper_set_dt(st, dt) ||
-        odhs_stepper_set_correction_interval(st, (unsigned)corr)) {
+        configure(st, integrator, dt, tol, corr)) {
         fprintf(stderr, "jam_packing: setup failed\n");
         return 1;
     }
-    fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s\n", n, odhs_system_dim(sys), protocol,
-            solver_name);
+    fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s, %s\n", n, odhs_system_dim(sys), protocol,
+            solver_name, integrator == ODHS_INTEGRATOR_HEUN ? "heun" : "euler");
 
     if (!strcmp(protocol, "compress")) {
         odhs_driver_set_compression_rate(drv, 1.0);
@@ -156,9 +173,7 @@ int main(int argc, char **argv)
             odhs_system_scale_box(sys, pow(1.002, 1.0 / odhs_system_dim(sys)));
             odhs_driver_set_compression_rate(drv, 0.0);
             odhs_driver_set_shear_rate(drv, 1.0);
-            if (odhs_stepper_create(sys, drv, solver, &st) ||
-                odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER) || odhs_stepper_set_dt(st, dt) ||
-                odhs_stepper_set_correction_interval(st, (unsigned)corr))
+            if (odhs_stepper_create(sys, drv, solver, &st) || configure(st, integrator, dt, tol, corr))
                 return 1;
             fprintf(stderr, "jam_packing: compression jammed at phi = %.6f; shearing at phi = %.6f\n", phi,
                     phi / 1.002);

@@ -240,6 +240,11 @@ static inline int odhs__can_open(int kind) { return kind != ODHS_CONTACT_PERMANE
 int odhs__net_add_wall(odhs_network *net, const odhs_wall *w);
 /* give a scratch copy `sub` of net's particles the same walls */
 int odhs__net_copy_walls(odhs_network *sub, const odhs_network *net);
+/* a scratch network with net's walls and its contacts idx[0..m-1] (every
+ * contact if idx is NULL), leaving out position `skip` of that list
+ * (SIZE_MAX: none), kinds, rest lengths and geometry copied; NULL when out
+ * of memory (lib/jamming.c) */
+odhs_network *odhs__net_subnet(const odhs_network *net, const size_t *idx, size_t m, size_t skip);
 /* whether particles i and j belong to the same rigid body */
 static inline int odhs__same_body(const odhs_network *net, size_t i, size_t j)
 {
@@ -300,6 +305,14 @@ int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const do
 void odhs__solver_invalidate(odhs_solver *s);
 int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, const double *f0);
 int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);
+/* fixed pressure: the kernel vector fs of S^T with <r|fs> = 0 (the volume as
+ * one more column of S) on a constrained subset with d(Nbar - 1) + 2
+ * contacts, max |fs| = 1, sign undetermined (lib/jamming.c) */
+int odhs__null_vector_volume(const odhs_network *net, odhs_solver *solver, double *fs);
+/* *excess = constraints in the constrained subset minus its degrees of
+ * freedom: 1 for an isostatic subset (potentially jammed), 2 with one more
+ * contact; LONG_MIN for an empty subset */
+int odhs__net_excess(const odhs_network *net, long *excess);
 
 /* ---- driver ---------------------------------------------------------------- */
 struct odhs_driver {
@@ -409,6 +422,11 @@ struct odhs_stepper {
     /* rewiring */
     odhs_change *rem; /* pairs removed during the current rewiring */
     size_t nrem, remcap;
+    /* fixed pressure on a potentially jammed network: net->f = freg + alpha f0
+     * with f0 then freg in fpj (2 nc); pj_bordered while net->f is of that form */
+    double *fpj;
+    size_t fpjcap;
+    int pj_bordered;
     odhs_change *chg;
     size_t nchg, chgcap;
     /* rollback snapshot: xs holds 3 nd doubles, positions then Us, Fs */

@@ -34,8 +34,10 @@ static int subset_contacts(const odhs_network *net, size_t **idx, size_t *m)
     return ODHS_OK;
 }
 
-/* smallest eigenvector of N restricted to the contacts idx[0..m-1] */
-static int null_dense(const odhs_network *net, const size_t *idx, size_t m, double *y)
+/* smallest eigenvector of N restricted to the contacts idx[0..m-1], or of
+ * N + r r^T with rv[a] = r of contact idx[a] (rv not NULL): the kernel of S^T
+ * with the volume as one more column of S (fixed pressure) */
+static int null_dense(const odhs_network *net, const size_t *idx, size_t m, const double *rv, double *y)
 {
     int d = net->dim;
     double *A = odhs__calloc(m * m, sizeof *A);
@@ -61,6 +63,7 @@ static int null_dense(const odhs_network *net, const size_t *idx, size_t m, doub
             if (net->cj[ca] == net->cj[cb] && net->cj[ca] < net->n) v += dot; /* walls have no block */
             if (net->ci[ca] == net->cj[cb]) v -= dot;
             if (net->cj[ca] == net->ci[cb]) v -= dot;
+            if (rv) v += rv[a] * rv[b];
             A[b * m + a] = v; /* (row a, column b), a <= b: upper triangle, column-major */
         }
     lapack_int found = 0;
@@ -80,33 +83,42 @@ static int null_dense(const odhs_network *net, const size_t *idx, size_t m, doub
     return st;
 }
 
-/* fix f0 at contact idx[kk] to 1, least squares for the others */
-static int null_sparse(const odhs_network *net, odhs_solver *solver, const size_t *idx, size_t m, size_t kk,
-                       double *y)
+odhs_network *odhs__net_subnet(const odhs_network *net, const size_t *idx, size_t m, size_t skip)
 {
     int d = net->dim;
     odhs_network *sub = odhs__net_new(d, net->n);
-    double *g = odhs__calloc(net->n * (size_t)d, sizeof *g);
-    double *x = odhs__calloc(m, sizeof *x);
-    int st = ODHS_OK;
-    if (!sub || !g || !x || odhs__net_copy_walls(sub, net)) {
-        st = ODHS_E_NOMEM;
-        goto done;
-    }
+    if (!sub || odhs__net_copy_walls(sub, net)) goto fail;
+    if (!idx) m = net->nc;
     for (size_t a = 0; a < m; ++a) {
-        if (a == kk) continue;
-        size_t c = idx[a];
+        if (a == skip) continue;
+        size_t c = idx ? idx[a] : a;
         size_t s = odhs__net_add(sub, net->ci[c], net->cj[c], net->kind[c]);
-        if (s == SIZE_MAX) {
-            st = ODHS_E_NOMEM;
-            goto done;
-        }
+        if (s == SIZE_MAX) goto fail;
         memcpy(sub->nrm + s * d, net->nrm + c * d, (size_t)d * sizeof(double));
         sub->rest[s] = net->rest[c];
         sub->dist[s] = net->dist[c];
         sub->gap[s] = net->gap[c];
     }
     sub->version++;
+    return sub;
+fail:
+    odhs_network_destroy(sub);
+    return NULL;
+}
+
+/* fix f0 at contact idx[kk] to 1, least squares for the others */
+static int null_sparse(const odhs_network *net, odhs_solver *solver, const size_t *idx, size_t m, size_t kk,
+                       double *y)
+{
+    int d = net->dim;
+    odhs_network *sub = odhs__net_subnet(net, idx, m, kk);
+    double *g = odhs__calloc(net->n * (size_t)d, sizeof *g);
+    double *x = odhs__calloc(m, sizeof *x);
+    int st = ODHS_OK;
+    if (!sub || !g || !x) {
+        st = ODHS_E_NOMEM;
+        goto done;
+    }
     /* S'^T y = -s_k^T: s_k has -n on i and +n on j */
     size_t ck = idx[kk];
     for (int k = 0; k < d; ++k) {
@@ -139,7 +151,7 @@ int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, 
         goto done;
     }
     if (!solver || m <= DENSE_MAX) {
-        st = null_dense(net, idx, m, y);
+        st = null_dense(net, idx, m, NULL, y);
     } else {
         /* try the most recently added contacts first: removing the contact
          * that made the subset isostatic leaves a full-rank network */
@@ -187,6 +199,110 @@ done:
     return st;
 }
 
+/* f0 fixed to 1 on contact idx[k1] and 0 on idx[k2], least squares for the
+ * others: a vector of a two-dimensional kernel of S^T (sub is the network of
+ * idx without k1 and k2) */
+static int kernel_fixed(const odhs_network *net, odhs_solver *solver, odhs_network *sub, const size_t *idx,
+                        size_t m, size_t k1, size_t k2, double *g, double *x, double *y)
+{
+    int d = net->dim;
+    size_t ck = idx[k1];
+    memset(g, 0, net->n * (size_t)d * sizeof *g);
+    for (int k = 0; k < d; ++k) {
+        g[net->ci[ck] * d + k] = net->nrm[ck * d + k];
+        if (net->cj[ck] < net->n) g[net->cj[ck] * d + k] = -net->nrm[ck * d + k];
+    }
+    int st = odhs_solver_solve_ls(solver, sub, g, x);
+    if (st) return st;
+    for (size_t a = 0, q = 0; a < m; ++a) y[a] = a == k1 ? 1.0 : a == k2 ? 0.0 : x[q++];
+    return ODHS_OK;
+}
+
+int odhs__null_vector_volume(const odhs_network *net, odhs_solver *solver, double *fs)
+{
+    size_t *idx = NULL, m = 0;
+    int st = subset_contacts(net, &idx, &m);
+    if (st) return odhs__neterr(net, st, "out of memory");
+    double *y = odhs__malloc_array(2 * m + 1, sizeof *y);
+    double *rv = odhs__malloc_array(m + 1, sizeof *rv);
+    double *F = odhs__malloc_array(net->n * (size_t)net->dim, sizeof *F);
+    double *full = odhs__calloc(net->nc + 1, sizeof *full);
+    double *x = odhs__calloc(m + 1, sizeof *x);
+    odhs_network *sub = NULL;
+    if (!y || !rv || !F || !full || !x) {
+        st = odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t a = 0; a < m; ++a) rv[a] = net->dist[idx[a]];
+    if (m < 2) {
+        st = odhs__neterr(net, ODHS_E_STATE, "too few contacts for a self-stress at zero pressure");
+        goto done;
+    }
+    if (!solver || m <= DENSE_MAX) {
+        st = null_dense(net, idx, m, rv, y);
+    } else {
+        /* two kernel vectors of S^T, from the network without the two most
+         * recently added contacts, then the combination without pressure */
+        size_t k1 = m - 1, k2 = m - 2;
+        size_t keep[2] = {k1 < k2 ? k1 : k2, k1 < k2 ? k2 : k1};
+        size_t *rest = odhs__malloc_array(m, sizeof *rest), q = 0;
+        if (!rest) {
+            st = ODHS_E_NOMEM;
+        } else {
+            for (size_t a = 0; a < m; ++a)
+                if (a != keep[0] && a != keep[1]) rest[q++] = idx[a];
+            sub = odhs__net_subnet(net, rest, q, SIZE_MAX);
+            odhs__free(rest);
+            if (!sub) st = ODHS_E_NOMEM;
+        }
+        if (!st) st = kernel_fixed(net, solver, sub, idx, m, k1, k2, F, x, y);
+        if (!st) st = kernel_fixed(net, solver, sub, idx, m, k2, k1, F, x, y + m);
+        if (!st) {
+            double r1 = 0.0, r2 = 0.0;
+            for (size_t a = 0; a < m; ++a) {
+                r1 += rv[a] * y[a];
+                r2 += rv[a] * y[m + a];
+            }
+            for (size_t a = 0; a < m; ++a) y[a] = r2 * y[a] - r1 * y[m + a];
+        }
+    }
+    if (st) {
+        st = odhs__neterr(net, st == ODHS_E_NOMEM ? st : ODHS_E_SINGULAR, "self-stress at zero pressure: %s",
+                          odhs_strerror(st));
+        goto done;
+    }
+    double big = 0.0;
+    for (size_t a = 0; a < m; ++a) big = fmax(big, fabs(y[a]));
+    if (!(big > 0.0)) {
+        st = odhs__neterr(net, ODHS_E_SINGULAR, "self-stress at zero pressure vanishes");
+        goto done;
+    }
+    for (size_t a = 0; a < m; ++a) full[idx[a]] = y[a] / big;
+    /* accept only a true kernel vector: S^T fs = 0 and <r|fs> = 0 */
+    odhs__net_ST(net, full, F);
+    double rmax = 0.0, rf = 0.0, rs = 0.0;
+    for (size_t k = 0; k < net->n * (size_t)net->dim; ++k) rmax = fmax(rmax, fabs(F[k]));
+    for (size_t a = 0; a < m; ++a) {
+        rf += rv[a] * full[idx[a]];
+        rs += fabs(rv[a] * full[idx[a]]);
+    }
+    if (!(rmax <= 1e-8) || !(fabs(rf) <= 1e-8 * rs)) {
+        st = odhs__neterr(net, ODHS_E_SINGULAR, "self-stress at zero pressure: residual %.3g, pressure %.3g", rmax,
+                          rf / rs);
+        goto done;
+    }
+    memcpy(fs, full, net->nc * sizeof *fs);
+done:
+    odhs_network_destroy(sub);
+    odhs__free(idx);
+    odhs__free(y);
+    odhs__free(rv);
+    odhs__free(F);
+    odhs__free(full);
+    odhs__free(x);
+    return st;
+}
+
 int odhs_network_null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual)
 {
     if (!net) return ODHS_E_NULL;
@@ -209,22 +325,11 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
     size_t k = 0;
     for (size_t c = 1; c < nc; ++c)
         if (fabs(f0[c]) > fabs(f0[k])) k = c;
-    odhs_network *sub = odhs__net_new(d, net->n);
+    odhs_network *sub = odhs__net_subnet(net, NULL, nc, k);
     double *y = odhs__calloc(nc, sizeof *y), *dR = odhs__calloc(nd, sizeof *dR);
-    size_t *map = odhs__malloc_array(nc, sizeof *map);
-    if (!sub || !y || !dR || !map || odhs__net_copy_walls(sub, net)) {
+    if (!sub || !y || !dR) {
         st = ODHS_E_NOMEM;
         goto done;
-    }
-    for (size_t c = 0; c < nc; ++c) {
-        if (c == k) continue;
-        map[sub->nc] = c;
-        size_t sc = odhs__net_add(sub, net->ci[c], net->cj[c], net->kind[c]);
-        if (sc == SIZE_MAX) {
-            st = ODHS_E_NOMEM;
-            goto done;
-        }
-        sub->rest[sc] = net->rest[c];
     }
     double prev = INFINITY;
     for (int pass = 0; pass < 12; ++pass) {
@@ -261,11 +366,9 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
     }
     odhs__net_geometry(net, sys);
 done:
-    (void)map;
     odhs_network_destroy(sub);
     odhs__free(y);
     odhs__free(dR);
-    odhs__free(map);
     return st;
 }
 

@@ -1,4 +1,5 @@
 /* libodhs - contact network, the operator S and the constrained subset. */
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -819,10 +820,8 @@ int odhs_network_rattlers(const odhs_network *net, unsigned char *is_rattler, si
     return ODHS_OK;
 }
 
-int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
+int odhs__net_excess(const odhs_network *net, long *excess)
 {
-    if (!net) return ODHS_E_NULL;
-    if (!flag) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
     core_ensure(net);
     size_t nb = net->nbar, nk = net->ncon;
     if (net->nperm) {
@@ -831,7 +830,18 @@ int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
     }
     /* isostatic: d Nbar - (global zero modes) constraints; one more is a
      * self-stress. Without walls the zero modes are the d translations. */
-    *flag = nb > 0 && nk + net->free_modes >= (size_t)net->dim * nb + 1;
+    *excess = nb == 0 ? LONG_MIN : (long)(nk + net->free_modes) - (long)((size_t)net->dim * nb);
+    return ODHS_OK;
+}
+
+int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!flag) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
+    long e;
+    int st = odhs__net_excess(net, &e);
+    if (st) return st;
+    *flag = e >= 1;
     return ODHS_OK;
 }
 

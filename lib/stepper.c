@@ -132,37 +132,21 @@ static int solve(odhs_stepper *st, const double *b, double *x)
     return ODHS_OK;
 }
 
-/* Solve for the contact forces (into net->f) and kappa under pressure control. */
-static int compute_forces(odhs_stepper *st)
+/* b = -S (V_aff + xi0 F) / xi0 on the current network (st->cb has room),
+ * with the pressure part of V_aff left out */
+static void affine_rhs(odhs_stepper *st, double *b)
 {
-    odhs_network *net = st->net;
-    odhs_driver *drv = st->drv;
+    const odhs_network *net = st->net;
+    const odhs_driver *drv = st->drv;
     size_t nc = net->nc;
-    int dim = st->dim, s;
+    int dim = st->dim;
     double xi0 = drv->xi0;
-    if ((s = reserve_contacts(st, nc))) return sterr(st, s, "out of memory");
-    if (!drv->pressure_on) {
-        set_gradient(st, drv->crate);
-        st->kappa = drv->gdot != 0.0 ? drv->crate / drv->gdot : drv->crate;
-        /* a subnormal shear rate overflows the ratio (found by fuzzing the
-         * checkpoint reader): report c as without shear, never inf */
-        if (!isfinite(st->kappa)) st->kappa = drv->crate;
-    }
-    if (nc == 0) {
-        if (drv->pressure_on) {
-            st->kappa = drv->kappa_max * (drv->gdot > 0 ? 1.0 : -1.0);
-            set_gradient(st, drv->gdot * st->kappa);
-        }
-        return ODHS_OK;
-    }
-    /* b = -S (V_aff + xi0 F) / xi0, with the pressure part of V_aff left out */
     double G0[9];
     memcpy(G0, st->G, sizeof G0);
     if (drv->pressure_on) {
         memset(G0, 0, sizeof G0);
         G0[3 * (0) + (1)] = drv->gdot;
     }
-    double *b = st->cb;
     for (size_t c = 0; c < nc; ++c) {
         const double *n = net->nrm + c * dim;
         if (net->nwalls && net->cj[c] >= st->n) {
@@ -188,10 +172,114 @@ static int compute_forces(odhs_stepper *st)
         }
         b[c] = -v / xi0;
     }
+}
+
+/* Fixed pressure on a potentially jammed network (d(Nbar - 1) + 1 contacts in
+ * the constrained subset): N is singular with the kernel f0, but the volume is
+ * one more degree of freedom, so the network is not jammed. N f = b + a r
+ * (a = gdot kappa / xi0) has a solution only for a = -<f0|b>/<f0|r>: kappa
+ * follows from the geometry. f = freg + alpha f0, with freg solved on the
+ * network without the contact k of largest |f0| (its row of S follows from
+ * the others through f0, and so does its equation), and alpha sets the
+ * pressure. The velocities see freg only (S^T f0 = 0). */
+/* N x = rhs on an isostatic network, rhs orthogonal to its self-stress f0:
+ * solved on the network without the contact k of largest |f0|, whose row of
+ * S (and equation) follows from the others through f0; x[k] = 0. rhs and x
+ * hold nc values (rhs is used as scratch); tol > 0: relaxed residual. */
+static int solve_isostatic(odhs_stepper *st, const double *f0, double *rhs, double *x, double tol)
+{
+    const odhs_network *net = st->net;
+    size_t nc = net->nc, k = 0;
+    for (size_t c = 1; c < nc; ++c)
+        if (fabs(f0[c]) > fabs(f0[k])) k = c;
+    memmove(rhs + k, rhs + k + 1, (nc - 1 - k) * sizeof *rhs);
+    odhs_network *sub = odhs__net_subnet(net, NULL, nc, k);
+    if (!sub) return sterr(st, ODHS_E_NOMEM, "out of memory");
+    memset(x, 0, nc * sizeof *x);
+    int s = tol > 0.0 ? odhs__solver_solve_relaxed(st->sol, sub, rhs, x, tol)
+                      : odhs__solver_solve(st->sol, sub, rhs, x, 1);
+    odhs_network_destroy(sub);
+    if (s) return sterr(st, s, "force solve on the isostatic network: %s", odhs_solver_errmsg(st->sol));
+    memmove(x + k + 1, x + k, (nc - 1 - k) * sizeof *x);
+    x[k] = 0.0;
+    return ODHS_OK;
+}
+
+/* f0 of the current (isostatic) network into st->fpj (room for 2 nc) */
+static int isostatic_f0(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    if (reserve((void **)&st->fpj, &st->fpjcap, 2 * net->nc, sizeof *st->fpj))
+        return sterr(st, ODHS_E_NOMEM, "out of memory");
+    int s = odhs__null_vector(net, st->sol, st->fpj, NULL);
+    if (s)
+        return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "fixed pressure, isostatic network: %s",
+                     net->errmsg);
+    return ODHS_OK;
+}
+
+static int pressure_isostatic_forces(odhs_stepper *st, const double *b)
+{
+    odhs_network *net = st->net;
+    odhs_driver *drv = st->drv;
+    size_t nc = net->nc;
+    int s;
+    if ((s = isostatic_f0(st))) return s;
+    double *f0 = st->fpj, *freg = st->fpj + nc, *rhs = st->cx;
+    double fb = 0.0, fr = 0.0;
+    for (size_t c = 0; c < nc; ++c) {
+        fb += f0[c] * b[c];
+        fr += f0[c] * net->dist[c];
+    }
+    if (!(fabs(fr) > 0.0))
+        return sterr(st, ODHS_E_SINGULAR, "fixed pressure, isostatic network: the self-stress carries no pressure");
+    double a = -fb / fr;
+    for (size_t c = 0; c < nc; ++c) rhs[c] = b[c] + a * net->dist[c];
+    if ((s = solve_isostatic(st, f0, rhs, freg, 0.0))) return s;
+    double vol, rf = 0.0;
+    odhs_system_volume(st->sys, &vol);
+    for (size_t c = 0; c < nc; ++c) rf += net->dist[c] * freg[c];
+    double alpha = (drv->p * vol * st->dim - rf) / fr;
+    for (size_t c = 0; c < nc; ++c) net->f[c] = freg[c] + alpha * f0[c];
+    st->kappa = a * drv->xi0 / drv->gdot;
+    set_gradient(st, drv->gdot * st->kappa);
+    st->pj_bordered = 1;
+    return ODHS_OK;
+}
+
+/* Solve for the contact forces (into net->f) and kappa under pressure control. */
+static int compute_forces(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    odhs_driver *drv = st->drv;
+    size_t nc = net->nc;
+    int dim = st->dim, s;
+    double xi0 = drv->xi0;
+    st->pj_bordered = 0;
+    if ((s = reserve_contacts(st, nc))) return sterr(st, s, "out of memory");
+    if (!drv->pressure_on) {
+        set_gradient(st, drv->crate);
+        st->kappa = drv->gdot != 0.0 ? drv->crate / drv->gdot : drv->crate;
+        /* a subnormal shear rate overflows the ratio (found by fuzzing the
+         * checkpoint reader): report c as without shear, never inf */
+        if (!isfinite(st->kappa)) st->kappa = drv->crate;
+    }
+    if (nc == 0) {
+        if (drv->pressure_on) {
+            st->kappa = drv->kappa_max * (drv->gdot > 0 ? 1.0 : -1.0);
+            set_gradient(st, drv->gdot * st->kappa);
+        }
+        return ODHS_OK;
+    }
+    double *b = st->cb;
+    affine_rhs(st, b);
     if (!drv->pressure_on) return solve(st, b, net->f);
 
     /* fixed pressure: f = x2 + (gdot kappa / xi0) x1 with N x2 = b, N x1 = r */
     st->work_pressure++;
+    long excess;
+    if ((s = odhs__net_excess(net, &excess))) return sterr(st, s, "%s", net->errmsg);
+    if (excess == 1) return pressure_isostatic_forces(st, b);
     double *x1 = st->cx;
     if ((s = solve(st, b, net->f))) return s;
     memset(x1, 0, nc * sizeof *x1);
@@ -218,7 +306,8 @@ static int compute_forces(odhs_stepper *st)
 static void compute_velocities(odhs_stepper *st)
 {
     double xi0 = st->drv->xi0;
-    odhs__net_ST(st->net, st->net->f, st->U);
+    /* freg: alpha f0 is a self-stress, and alpha may be huge */
+    odhs__net_ST(st->net, st->pj_bordered ? st->fpj + st->net->nc : st->net->f, st->U);
     for (size_t k = 0; k < st->nd; ++k) st->U[k] = xi0 * (st->U[k] + (st->has_F ? st->F[k] : 0.0));
 }
 
@@ -275,6 +364,55 @@ static void contact_geometry(odhs_stepper *st, size_t c)
     net->version++;
 }
 
+/* Forces for the rewiring: on a potentially jammed network (*pj = 1 on
+ * return) the self-stress f0 (Sect. IV D); under fixed pressure, where the
+ * volume can still change, f0 only when it is positive (jammed at this
+ * volume), else the forces of the flowing isostatic network (*pj = 0). A
+ * failed f0 is ODHS_POTENTIALLY_JAMMED (or ODHS_E_NOMEM). */
+static int rewire_forces(odhs_stepper *st, int *pj)
+{
+    odhs_network *net = st->net;
+    int s;
+    long excess;
+    st->pj_bordered = 0;
+    if ((s = odhs__net_excess(net, &excess))) return sterr(st, s, "%s", net->errmsg);
+    *pj = excess >= 1;
+    if (!*pj) return compute_forces(st);
+    if (st->drv->pressure_on && excess == 2) {
+        /* fixed pressure, one contact more than isostatic: the forces
+         * diverge along the self-stress fs at zero pressure, with the sign
+         * that resists the driving (<fs|b> > 0); its most negative contact
+         * opens (fs has both signs, since <fs|r> = 0) */
+        if ((s = reserve_contacts(st, net->nc))) return sterr(st, s, "out of memory");
+        affine_rhs(st, st->cb);
+        if ((s = odhs__null_vector_volume(net, st->sol, net->f)))
+            return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "fixed pressure at t = %.17g: %s",
+                         st->time, net->errmsg);
+        double fb = 0.0, fmin = 0.0;
+        for (size_t c = 0; c < net->nc; ++c) fb += net->f[c] * st->cb[c];
+        for (size_t c = 0; c < net->nc; ++c) {
+            if (fb < 0.0) net->f[c] = -net->f[c];
+            if (odhs__can_open(net->kind[c])) fmin = fmin < net->f[c] ? fmin : net->f[c];
+        }
+        if (!(fmin < -EPS_F))
+            return sterr(st, ODHS_POTENTIALLY_JAMMED,
+                         "fixed pressure at t = %.17g: the self-stress at zero pressure opens no contact", st->time);
+        return ODHS_OK;
+    }
+    if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
+        return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "potentially jammed at t = %.17g: %s",
+                     st->time, net->errmsg);
+    if (!st->drv->pressure_on) return ODHS_OK;
+    double fmax = 0.0;
+    for (size_t c = 0; c < net->nc; ++c) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
+    for (size_t c = 0; c < net->nc; ++c)
+        if (odhs__can_open(net->kind[c]) && net->f[c] < -EPS_F * fmax) {
+            *pj = 0;
+            return compute_forces(st);
+        }
+    return ODHS_OK;
+}
+
 /* Rewiring (Sect. IV B): remove the most negative force until none is left,
  * then re-connect the most approaching removed pair, and repeat. */
 static int rewire(odhs_stepper *st)
@@ -289,14 +427,7 @@ static int rewire(odhs_stepper *st)
         /* Sect. IV D: on a potentially jammed network N is singular and the
          * self-stress f0 plays the part of the forces */
         int pj = 0;
-        if ((s = odhs_network_potentially_jammed(net, &pj))) return sterr(st, s, "%s", net->errmsg);
-            if (pj) {
-            if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
-                return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED,
-                             "potentially jammed at t = %.17g: %s", st->time, net->errmsg);
-        } else if ((s = compute_forces(st))) {
-            return s;
-        }
+        if ((s = rewire_forces(st, &pj))) return s;
         double fmax = 0.0, fmin = 0.0;
         size_t kmin = SIZE_MAX;
         for (size_t c = 0; c < net->nc; ++c) {
@@ -850,7 +981,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
     if (!st) return;
     odhs_network_destroy(st->net);
     void *arrays[] = {st->disps, st->U0, st->Ua, st->Up, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
-                      st->rem, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->srest, st->ev, st->wsnap};
+                      st->rem, st->fpj, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->srest, st->ev, st->wsnap};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
 }
@@ -996,6 +1127,27 @@ fail:
 }
 
 /* ---- drift correction (Sect. IV C) ------------------------------------- */
+/* Drift correction of an isostatic network under fixed pressure (see
+ * correct): fills Z with the isotropic gradient and st->cx with the
+ * correction's contact forces (zero on contact k). */
+static int correct_isostatic(odhs_stepper *st, double *Z)
+{
+    odhs_network *net = st->net;
+    size_t nc = net->nc;
+    int s;
+    if ((s = isostatic_f0(st))) return s;
+    double *f0 = st->fpj, *rhs = st->fpj + nc;
+    double fg = 0.0, fr = 0.0;
+    for (size_t c = 0; c < nc; ++c) {
+        fg += f0[c] * net->gap[c];
+        fr += f0[c] * net->dist[c];
+    }
+    double eps = fr != 0.0 ? fg / fr : 0.0;
+    for (int a = 0; a < st->dim; ++a) Z[3 * a + a] = -eps;
+    for (size_t c = 0; c < nc; ++c) rhs[c] = net->gap[c] - eps * net->dist[c];
+    return solve_isostatic(st, f0, rhs, st->cx, 1e-7);
+}
+
 static int correct(odhs_stepper *st, int *added)
 {
     odhs_network *net = st->net;
@@ -1016,19 +1168,31 @@ static int correct(odhs_stepper *st, int *added)
             gmax = fmax(gmax, fabs(net->gap[c]) / odhs__net_sigma(net, sys, c));
         if (gmax <= 4e-16) return ODHS_OK;            /* at round-off */
         if (!(gmax < 0.5 * prev)) return ODHS_OK;     /* no further progress */
-        int isostatic = 0;
-        if ((s = odhs_network_potentially_jammed(net, &isostatic))) return sterr(st, s, "%s", net->errmsg);
-        if (isostatic) return ODHS_OK; /* N singular: the rewiring handles it (f0) */
+        long excess;
+        if ((s = odhs__net_excess(net, &excess))) return sterr(st, s, "%s", net->errmsg);
+        if (excess >= 1 && !(excess == 1 && st->drv->pressure_on))
+            return ODHS_OK; /* N singular: the rewiring handles it (f0) */
         prev = gmax;
         memset(st->cx, 0, nc * sizeof *st->cx);
-        /* the gaps are small: a relative residual of 1e-7 removes them to
-         * round-off in one pass (a further pass follows if not) */
-        s = odhs__solver_solve_relaxed(st->sol, net, net->gap, st->cx, 1e-7);
-        if (s) s = sterr(st, s, "force solve: %s", odhs_solver_errmsg(st->sol));
+        memset(Z, 0, sizeof Z);
+        if (excess == 1) {
+            /* fixed pressure, flowing on an isostatic network: N is singular,
+             * but the volume is free. The gap component along f0 goes with an
+             * isotropic rescaling (gradient Z = -eps I over the unit
+             * correction time, eps = <f0|gap>/<f0|r>), the rest on the network
+             * without the contact k of largest |f0| (its row of S follows
+             * from the others through f0), as when a packing is polished */
+            s = correct_isostatic(st, Z);
+        } else {
+            /* the gaps are small: a relative residual of 1e-7 removes them to
+             * round-off in one pass (a further pass follows if not) */
+            s = odhs__solver_solve_relaxed(st->sol, net, net->gap, st->cx, 1e-7);
+            if (s) s = sterr(st, s, "force solve: %s", odhs_solver_errmsg(st->sol));
+        }
         if (s) {
             /* a (nearly) redundant contact makes N singular for this
              * right-hand side: the correction waits for the next interval */
-            if (s == ODHS_E_SINGULAR || s == ODHS_E_NOCONV) {
+            if (s == ODHS_E_SINGULAR || s == ODHS_E_NOCONV || s == ODHS_POTENTIALLY_JAMMED) {
                 odhs__solver_invalidate(st->sol); /* its failed setup is not reusable */
                 return ODHS_OK;
             }
@@ -1382,9 +1546,11 @@ again:;
         /* locate an opening inside the step: forces are smooth in time, so
          * the first zero crossing t* = t f0/(f0 - f1) (second-order accurate)
          * ends a repeated, shorter step, instead of the step's end */
-        int pj = 0;
-        odhs_network_potentially_jammed(net, &pj);
-        if (!pj && (s = compute_forces(st)) == ODHS_OK) {
+        long excess = 0;
+        odhs__net_excess(net, &excess);
+        /* under fixed pressure an isostatic network still flows */
+        int flows = excess < 1 || (st->drv->pressure_on && excess == 1);
+        if (flows && (s = compute_forces(st)) == ODHS_OK) {
             double fbig = 0.0, tstar = INFINITY;
             for (size_t c = 0; c < net->nc; ++c) fbig = fmax(fbig, fabs(net->f[c]));
             for (size_t c = 0; c < net->nc; ++c) {

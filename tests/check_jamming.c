@@ -16,13 +16,13 @@
  *  - "rattlers": the constrained subset is found by iterated removal (a
  *    chain that becomes rattlers one particle at a time), in 2D and 3D.
  *  - "packings": packings produced by the stepper driven as
- *    examples/jam_packing.c does (compress and shear+compress in 2D, compress
- *    in 3D) pass the certificate, and the certificate is checked against an
+ *    examples/jam_packing.c does (compress, shear+compress and fixed pressure
+ *    in 2D, compress in 3D) pass the certificate, and the certificate is checked against an
  *    independent recomputation (brute-force overlaps over lattice images, own
  *    rattler removal, own force balance, own SVD of S^T).
- *  - "known_failures" (only with ODHS_JAMMING_KNOWN_FAILURES set): the same
- *    for the shear+compress and fixed-pressure cases that this version fails
- *    (see docs/jamming.md, "Known problems").
+ *  - "pressure": under fixed pressure an isostatic network with f0 of both
+ *    signs flows (the volume is one more degree of freedom): pressure,
+ *    rigidity and U = xi0 S^T f checked at every step that ends on one.
  *  - "large": on a network with more than 600 backbone contacts the solver
  *    route of odhs_network_null_vector equals the LAPACK route to 1e-10.
  *  - "io": odhs_contacts_write round trip, odhs_svg_write well-formedness, and
@@ -760,7 +760,8 @@ typedef struct {
 
 /* The scene and settings of examples/jam_packing.c: 50:50 bidisperse radii
  * 0.5/0.7, 3% polydispersity, random placement at phi = 0.45 (2D) / 0.30
- * (3D); Euler dt = 1e-3, drift correction every step (its --correction 1). */
+ * (3D); the default adaptive integrator, drift correction every step (its
+ * --correction 1). */
 static void jrun_start(jrun *r, int dim, size_t n, uint64_t seed, const char *protocol, const char *solver)
 {
     memset(r, 0, sizeof *r);
@@ -932,36 +933,22 @@ static const struct {
     uint64_t seed;
     const char *protocol;
 } pack_cases[] = {
-    /* Driven as jam_packing drives them (correction every step, cholmod-pcg
-     * when available). The shear+compress and fixed-pressure cases that do not
-     * yet pass the certificate (shear+compress seed 2: min_force < 0 after
-     * polishing, seed 3: a 1e-3 overlap; fixed pressure: the rewiring cycles)
-     * are known failures recorded in the Jammed-packings issue; they are in
-     * known_failure_cases below and left out of the default run until fixed. */
-    {2, 64, 1, "compress"},       {2, 64, 2, "compress"}, {2, 64, 3, "compress"}, {2, 128, 1, "compress"},
-    {2, 64, 1, "shear+compress"}, {2, 128, 1, "shear+compress"},
-    {3, 48, 1, "compress"},       {3, 64, 1, "compress"}, {3, 64, 2, "compress"},
-};
-#define N_PACK_CASES ((int)(sizeof pack_cases / sizeof pack_cases[0]))
-
-/* The cases left out above, run only when ODHS_JAMMING_KNOWN_FAILURES is set
- * in the environment (test case "known_failures"), to check fixes. With this
- * version they fail: shear+compress seed 2 (min_force < 0 after polishing),
- * seed 3 (overlap 1.1e-3), seed 4 and all fixed-pressure cases (rewiring
- * cycle, ODHS_E_REWIRE); pressure at N = 128 with cholmod-pcg writes past a
- * CHOLMOD buffer (heap-buffer-overflow in pcg_precond, lib/solvers/cholmod.c;
- * a crash, so it is the last case). */
-static const struct {
-    int dim;
-    size_t n;
-    uint64_t seed;
-    const char *protocol;
-} known_failure_cases[] = {
+    /* Driven as jam_packing drives them (the library's default adaptive
+     * integrator, correction every step, cholmod-pcg when available). The
+     * shear+compress seeds 2-4 and the fixed-pressure cases were known
+     * failures of version 0.2.0 and earlier (a negative f0 after polishing,
+     * an overlap of 1e-3, and the rewiring cycling under fixed pressure,
+     * where isostatic networks were taken as jammed or stuck); they pass
+     * since isostatic networks flow under fixed pressure and the drift
+     * correction covers them. */
+    {2, 64, 1, "compress"},       {2, 64, 2, "compress"},       {2, 64, 3, "compress"},
+    {2, 128, 1, "compress"},      {2, 64, 1, "shear+compress"}, {2, 128, 1, "shear+compress"},
     {2, 64, 2, "shear+compress"}, {2, 64, 3, "shear+compress"}, {2, 64, 4, "shear+compress"},
     {2, 64, 1, "pressure"},       {2, 64, 2, "pressure"},       {2, 64, 3, "pressure"},
-    {2, 128, 1, "pressure"},
+    {2, 64, 5, "pressure"},       {2, 64, 6, "pressure"},       {2, 128, 1, "pressure"},
+    {3, 48, 1, "compress"},       {3, 64, 1, "compress"},       {3, 64, 2, "compress"},
 };
-#define N_KNOWN_FAILURES ((int)(sizeof known_failure_cases / sizeof known_failure_cases[0]))
+#define N_PACK_CASES ((int)(sizeof pack_cases / sizeof pack_cases[0]))
 
 /* One packing: the run must end with ODHS_JAMMED, the certificate must pass,
  * and the independent recomputation must agree. */
@@ -1016,10 +1003,126 @@ START_TEST(test_packing_certified)
 }
 END_TEST
 
-START_TEST(test_packing_known_failure)
+
+/* ========================================================================== */
+/* Fixed pressure through isostatic networks                                  */
+/* ========================================================================== */
+/*
+ * Under fixed pressure the volume is one more degree of freedom: a network
+ * with d(Nbar - 1) + 1 contacts in the constrained subset is singular for
+ * N = S S^T but not for the dynamics, whose kappa follows from <f0|b + a r> = 0
+ * and whose forces are f = freg + alpha f0. With f0 of both signs such a
+ * network flows (before, the rewiring used f0 as the forces there and cycled:
+ * jam_packing --protocol pressure --n 64 --seed 4, 5, 6). This drives 2D
+ * N = 64 seed 4 as jam_packing does (pressure doubled every 0.05 strain) step
+ * by step, and at every step that ends on a flowing isostatic network checks
+ * the exact identities independently: pressure <f|r>/(Omega d) = p, every
+ * contact rigid ((S U)_c + (S V_aff)_c = 0 with the stepper's kappa), forces
+ * >= 0, and force balance V - V_aff = xi0 S^T f up to the self-stress (S^T f0
+ * = 0, so only freg moves particles: the check is U = xi0 S^T f). The run must
+ * end jammed with a passing certificate and visit such networks.
+ */
+START_TEST(test_pressure_isostatic_flow)
 {
-    packing_certified(known_failure_cases[_i].dim, known_failure_cases[_i].n, known_failure_cases[_i].seed,
-                      known_failure_cases[_i].protocol);
+    const uint64_t seed = 4; /* 30 steps end on flowing isostatic networks */
+    jrun r;
+    jrun_start(&r, 2, 64, seed, "pressure", "default");
+    CHECK_OK(odhs_driver_set_shear_rate(r.drv, 1.0));
+    CHECK_OK(odhs_driver_set_pressure(r.drv, 1.0));
+    size_t n = r.n, nd = 2 * n;
+    double *U = xcalloc(nd, sizeof *U), *F = xcalloc(nd, sizeof *F), *rad = xcalloc(n, sizeof *rad);
+    CHECK_OK(odhs_system_get_radii(r.sys, rad));
+    double p = 1.0, gnext = 0.05, worst_p = 0.0, worst_rig = 0.0, worst_bal = 0.0, fneg = 0.0;
+    long iso = 0, steps = 0;
+    int rc = ODHS_OK;
+    while (rc == ODHS_OK && steps < 200000) {
+        rc = odhs_stepper_step(r.st, NULL);
+        steps++;
+        if (rc) break;
+        const odhs_network *net = odhs_stepper_network(r.st);
+        int pj = 0;
+        CHECK_OK(odhs_network_potentially_jammed(net, &pj));
+        if (pj) {
+            iso++;
+            size_t m = odhs_network_count(net);
+            double *f = xcalloc(m, sizeof *f), *gap = xcalloc(m, sizeof *gap), *nrm = xcalloc(2 * m, sizeof *nrm);
+            CHECK_OK(odhs_network_get_forces(net, f));
+            CHECK_OK(odhs_network_get_gaps(net, gap));
+            CHECK_OK(odhs_network_get_normals(net, nrm));
+            CHECK_OK(odhs_stepper_nonaffine_velocities(r.st, U));
+            double kappa, vol, L[3] = {0, 0, 0};
+            CHECK_OK(odhs_stepper_kappa(r.st, &kappa));
+            CHECK_OK(odhs_system_volume(r.sys, &vol));
+            CHECK_OK(odhs_system_get_box(r.sys, L));
+            double fr = 0.0, fbig = 0.0, umax = 0.0;
+            memset(F, 0, nd * sizeof *F);
+            for (size_t c = 0; c < m; ++c) {
+                size_t i, j;
+                CHECK_OK(odhs_network_get_contact(net, c, &i, &j, NULL));
+                double dist = gap[c] + rad[i] + rad[j];
+                fr += f[c] * dist;
+                fbig = fmax(fbig, fabs(f[c]));
+                for (int k = 0; k < 2; ++k) {
+                    F[i * 2 + k] -= f[c] * nrm[c * 2 + k];
+                    F[j * 2 + k] += f[c] * nrm[c * 2 + k];
+                }
+            }
+            for (size_t k = 0; k < nd; ++k) umax = fmax(umax, fabs(U[k]));
+            double vs = umax + (1.0 + fabs(kappa)) * 2.0 * 0.7;
+            for (size_t c = 0; c < m; ++c) {
+                size_t i, j;
+                CHECK_OK(odhs_network_get_contact(net, c, &i, &j, NULL));
+                double dist = gap[c] + rad[i] + rad[j], su = 0.0;
+                for (int k = 0; k < 2; ++k) su += (U[j * 2 + k] - U[i * 2 + k]) * nrm[c * 2 + k];
+                double aff = dist * (nrm[c * 2] * nrm[c * 2 + 1] - kappa);
+                worst_rig = fmax(worst_rig, fabs(su + aff) / vs);
+                fneg = fmin(fneg, f[c] / fbig);
+            }
+            /* U = xi0 S^T f (xi0 = 1) holds for freg; alpha f0 adds round-off
+             * of order eps alpha, so compare on the force scale */
+            for (size_t k = 0; k < nd; ++k) worst_bal = fmax(worst_bal, fabs(U[k] - F[k]) / (umax + 1e-16 * fbig));
+            worst_p = fmax(worst_p, fabs(fr / (2.0 * vol) - p) / p);
+            free(f);
+            free(gap);
+            free(nrm);
+        }
+        double g;
+        CHECK_OK(odhs_stepper_strain(r.st, &g));
+        if (g >= gnext) {
+            p *= 2.0;
+            gnext += 0.05;
+            CHECK_OK(odhs_driver_set_pressure(r.drv, p));
+        }
+    }
+    r.rc = rc;
+    char head[96], cmsg[512] = "", imsg[768] = "";
+    snprintf(head, sizeof head, "2D N = 64 seed %llu pressure", (unsigned long long)seed);
+    int ok_cert = 0, ind = 0;
+    if (rc == ODHS_JAMMED) {
+        odhs_jam_certificate c;
+        c.size = sizeof c;
+        CHECK_OK(odhs_stepper_certificate(r.st, &c));
+        cert_print(cmsg, sizeof cmsg, &c);
+        ok_cert = cert_passes(&c, 2);
+        ind = independent_check(&r, imsg, sizeof imsg);
+    }
+    char msg[160];
+    snprintf(msg, sizeof msg, "%s", odhs_stepper_errmsg(r.st));
+    fprintf(stderr,
+            "[jamming] %s: %ld steps, %ld on flowing isostatic networks: pressure %.2e, rigidity %.2e, "
+            "U - xi0 S^T f %.2e, most negative force %.2e; end %d\n",
+            head, steps, iso, worst_p, worst_rig, worst_bal, fneg, rc);
+    free(U);
+    free(F);
+    free(rad);
+    jrun_free(&r);
+    ck_assert_msg(rc == ODHS_JAMMED, "%s: ended with %d (%s)", head, rc, msg);
+    ck_assert_msg(iso > 0, "%s: no flowing isostatic network visited (the test does not exercise it)", head);
+    ck_assert_msg(worst_p <= 1e-9, "%s: pressure off by %.3g", head, worst_p);
+    ck_assert_msg(worst_rig <= 1e-9, "%s: rigidity violated by %.3g", head, worst_rig);
+    ck_assert_msg(worst_bal <= 1e-8, "%s: U - xi0 S^T f = %.3g", head, worst_bal);
+    ck_assert_msg(fneg >= -1e-12, "%s: negative force %.3g", head, fneg);
+    ck_assert_msg(ok_cert && ind, "%s: certificate %s; %s", head, cmsg, imsg);
 }
 END_TEST
 
@@ -1548,6 +1651,11 @@ Suite *make_jamming_suite(void)
     tcase_add_test(tc, test_rattler_chain_3d);
     suite_add_tcase(s, tc);
 
+    tc = tcase_create("pressure");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, test_pressure_isostatic_flow);
+    suite_add_tcase(s, tc);
+
     tc = tcase_create("large");
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, test_null_vector_large);
@@ -1567,11 +1675,5 @@ Suite *make_jamming_suite(void)
     tcase_set_timeout(tc, 600);
     tcase_add_loop_test(tc, test_packing_certified, 0, N_PACK_CASES);
     suite_add_tcase(s, tc);
-    if (getenv("ODHS_JAMMING_KNOWN_FAILURES")) {
-        tc = tcase_create("known_failures");
-        tcase_set_timeout(tc, 600);
-        tcase_add_loop_test(tc, test_packing_known_failure, 0, N_KNOWN_FAILURES);
-        suite_add_tcase(s, tc);
-    }
     return s;
 }
