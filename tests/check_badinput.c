@@ -1917,6 +1917,7 @@ static int huge_rate_case(void)
     X(sc_set_min_tolerance_null, odhs_softcore_set_min_tolerance, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_min_tolerance(NULL, 1e-9, 10);) \
     X(sc_set_linear_tolerance_null, odhs_softcore_set_linear_tolerance, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_linear_tolerance(NULL, 1e-10);) \
     X(sc_set_positions_null, odhs_softcore_set_positions, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_positions(NULL, w->x0);) \
+    X(sc_scale_box_null, odhs_softcore_scale_box, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_scale_box(NULL, 0.9);) \
     X(sc_set_velocities_null, odhs_softcore_set_velocities, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_set_velocities(NULL, w->x0);) \
     X(sc_reset_null, odhs_softcore_reset, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_reset(NULL);) \
     X(sc_step_null, odhs_softcore_step, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_softcore_step(NULL);) \
@@ -1966,6 +1967,11 @@ static int huge_rate_case(void)
     X(sc_pos_nullx, odhs_softcore_set_positions, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_positions(sc, NULL));) \
     X(sc_pos_nan, odhs_softcore_set_positions, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_pos_nan(w, sc));) \
     X(sc_pos_far, odhs_softcore_set_positions, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_pos_far(w, sc));) \
+    X(sc_scale_zero, odhs_softcore_scale_box, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, 0.0));) \
+    X(sc_scale_neg, odhs_softcore_scale_box, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, -0.5));) \
+    X(sc_scale_nan, odhs_softcore_scale_box, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, NAN_));) \
+    X(sc_scale_inf, odhs_softcore_scale_box, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, 1.0 / 0.0));) \
+    X(sc_scale_tiny, odhs_softcore_scale_box, ODHS_E_BOX, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, 1e-3));) \
     X(sc_vel_nullu, odhs_softcore_set_velocities, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_velocities(sc, NULL));) \
     X(sc_vel_nan, odhs_softcore_set_velocities, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_vel_nan(sc));) \
     X(sc_step_rd0_nodrag, odhs_softcore_step, ODHS_E_UNSUPPORTED, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, (odhs_softcore_set_drag(sc, 0.0), odhs_softcore_step(sc)));) \

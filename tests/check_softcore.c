@@ -76,6 +76,55 @@ static double energy(odhs_softcore *sc)
     return U;
 }
 
+/* odhs_softcore_scale_box: an affine isotropic compression into overlap. Two
+ * discs of radius 0.5 touching along x in a 4 x 4 box, scaled by s: the
+ * separation becomes s, the harmonic energy (1/2)(1 - s)^2 (k_e = 1), the
+ * overlap 1 - s, the box s L and phi phi0 / s^2, exactly; positions scale
+ * about the origin. A factor that would make the box too small is refused
+ * with the system unchanged bit for bit. */
+START_TEST(test_scale_box)
+{
+    odhs_system *sys;
+    odhs_softcore *sc;
+    CHECK_OK(odhs_system_create(2, 2, &sys));
+    double L[3] = {4.0, 4.0, 1.0}, r[2] = {0.5, 0.5}, x[4] = {1.5, 2.0, 2.5, 2.0};
+    CHECK_OK(odhs_system_set_box(sys, L));
+    CHECK_OK(odhs_system_set_radii(sys, r));
+    CHECK_OK(odhs_system_set_positions(sys, x));
+    CHECK_OK(odhs_softcore_create(sys, &sc));
+    CHECK_OK(odhs_softcore_set_potential(sc, 2.0, 1.0));
+    double phi0, phi, U, ov, L2[3], x2[4];
+    CHECK_OK(odhs_system_packing_fraction(sys, &phi0));
+    ck_assert(fabs(energy(sc)) == 0.0);
+    const double s = 0.875; /* exact in binary */
+    CHECK_OK(odhs_softcore_scale_box(sc, s));
+    CHECK_OK(odhs_system_get_box(sys, L2));
+    CHECK_OK(odhs_system_get_positions(sys, x2));
+    CHECK_OK(odhs_system_packing_fraction(sys, &phi));
+    U = energy(sc);
+    CHECK_OK(odhs_softcore_max_overlap(sc, &ov));
+    ck_assert_msg(L2[0] == s * L[0] && L2[1] == s * L[1], "box %.17g %.17g", L2[0], L2[1]);
+    for (int k = 0; k < 4; ++k) ck_assert_msg(x2[k] == s * x[k], "x[%d] = %.17g", k, x2[k]);
+    ck_assert_msg(fabs(phi - phi0 / (s * s)) <= 1e-15 * phi, "phi %.17g, expected %.17g", phi, phi0 / (s * s));
+    ck_assert_msg(fabs(U - 0.5 * (1.0 - s) * (1.0 - s)) <= 1e-15, "energy %.17g", U);
+    ck_assert_msg(fabs(ov - (1.0 - s)) <= 1e-15, "overlap %.17g", ov);
+    /* and back: no overlap, no energy */
+    CHECK_OK(odhs_softcore_scale_box(sc, 1.0 / s));
+    ck_assert_msg(fabs(energy(sc)) <= 1e-30, "energy after dilation %.3g", energy(sc));
+    /* refused: edge 4 * 0.2 = 0.8 < 2 largest diameters; nothing changes */
+    double L3[3], x3[4];
+    CHECK_OK(odhs_system_get_box(sys, L2));
+    CHECK_OK(odhs_system_get_positions(sys, x2));
+    ck_assert_int_eq(odhs_softcore_scale_box(sc, 0.2), ODHS_E_BOX);
+    ck_assert(strstr(odhs_softcore_errmsg(sc), "box edge") != NULL);
+    CHECK_OK(odhs_system_get_box(sys, L3));
+    CHECK_OK(odhs_system_get_positions(sys, x3));
+    ck_assert(memcmp(L2, L3, 2 * sizeof(double)) == 0 && memcmp(x2, x3, sizeof x2) == 0);
+    odhs_softcore_destroy(sc);
+    odhs_system_destroy(sys);
+}
+END_TEST
+
 static void fd_case(int dim, double alpha)
 {
     odhs_softcore *sc;
@@ -467,6 +516,7 @@ Suite *make_softcore_suite(void)
     Suite *s = suite_create("softcore");
     TCase *tc = tcase_create("core");
     tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_scale_box);
     tcase_add_test(tc, test_fd);
     tcase_add_test(tc, test_sd);
     tcase_add_test(tc, test_minimisers);

@@ -174,6 +174,16 @@ ODHS_API int odhs_softcore_set_linear_tolerance(odhs_softcore *sc, double tol);
  * ODHS_E_NULL, ODHS_E_NONFINITE.
  */
 ODHS_API int odhs_softcore_set_positions(odhs_softcore *sc, const double *x);
+/**
+ * Scale the box and every position by s (> 0) about the origin: an affine
+ * isotropic compression (s < 1) or dilation (s > 1) that, unlike
+ * odhs_system_scale_box, may create overlaps (soft-sphere jamming protocols
+ * compress and minimise). The strain, radii and velocities are kept.
+ * Errors: ODHS_E_NULL, ODHS_E_NONFINITE, ODHS_E_INVALID (s <= 0), ODHS_E_BOX
+ * (an edge would be shorter than twice the largest diameter); the system is
+ * then unchanged. (Since 0.2.1.)
+ */
+ODHS_API int odhs_softcore_scale_box(odhs_softcore *sc, double s);
 /** Set the non-affine velocities u[0..n*dim-1] (massive models; the
  *  overdamped models compute them). ODHS_E_NONFINITE for NaN/Inf. */
 ODHS_API int odhs_softcore_set_velocities(odhs_softcore *sc, const double *u);
