@@ -18,8 +18,8 @@
  *
  * Scene: 50:50 bidisperse discs/spheres, radii 0.5 and 0.7 (ratio 1.4), 3%
  * uniform polydispersity, random sequential placement at phi = 0.45 (2D) /
- * 0.30 (3D), then isotropic compression (rate 1, V_aff = -R) with the paper's
- * Euler scheme (dt = 1e-3 tau, drift correction every step) until the
+ * 0.30 (3D), then isotropic compression (rate 1, V_aff = -R) with the
+ * library's default adaptive integrator (drift correction every step) until the
  * stepper returns ODHS_JAMMED (isostatic backbone, positive self-stress).
  * A packing is "certified" when its certificate has jammed = isostatic = 1,
  * force balance < 1e-12, contact gaps < 1e-13, overlaps <= 1e-14, smallest
@@ -33,7 +33,12 @@
  *     N^4 with dense); the sizes skipped are printed.
  *  2. time to a certified packing for N = 256, 512, 1024, 4096 (2D) and 1000 (3D),
  *     each size run only if its estimated time fits the remaining budget.
- *  3. soft-sphere comparison: not available (no soft-core module yet).
+ *  3. the soft-sphere route (harmonic repulsion, compress and minimise with
+ *     FIRE, bisection on phi: O'Hern et al. 2003) from the same starts as the
+ *     event-driven packings of 2D N = 256, 1024 and 3D N = 128 (seed 1):
+ *     time, phi_J bracket, overlaps at jamming, against the event-driven
+ *     packing (exact contacts, certified). ODHS_BENCH_SOFT_LIMIT (seconds,
+ *     default 3600) bounds each of these runs.
  *
  * Every packing runs in a child process (fork), so a run that exceeds its
  * time limit is killed and reported instead of stalling the benchmark.
@@ -86,6 +91,13 @@ typedef struct {
     uint64_t steps, collisions, openings;
     odhs_jam_certificate cert;
     double f0_diff; /* max |f0(LAPACK) - f0(solver route)|, NAN if not run    */
+    /* soft: the soft-sphere route instead (table 3); its results */
+    int soft;
+    double s_phi_lo, s_phi_hi; /* last unjammed and first jammed phi        */
+    double s_overlap, s_z, s_fres; /* at the first jammed state: largest
+                                    * overlap / d_ij, z without rattlers,
+                                    * largest residual force              */
+    uint64_t s_mins, s_iters; /* minimisations and FIRE iterations           */
 } result;
 
 static char solver_name[32] = "dense";
@@ -98,9 +110,78 @@ static int certified(const odhs_jam_certificate *c, int dim)
            c->n_contacts_backbone == (size_t)dim * (c->n_backbone - 1) + 1;
 }
 
+/* The soft-sphere route (O'Hern, Silbert, Liu & Nagel 2003) on the same
+ * start: harmonic repulsion (k_e = 1), compress affinely by dphi, minimise
+ * with FIRE to max |F| < SOFT_FTOL; the state is jammed when the energy per
+ * particle exceeds SOFT_EJAM. A jammed state sends the system back to the
+ * last unjammed one and halves dphi, until dphi < SOFT_DPHI_END: phi_J lies
+ * between the last unjammed and the first jammed phi. */
+#define SOFT_FTOL 1e-14
+#define SOFT_EJAM 1e-16
+#define SOFT_DPHI0 1e-3
+#define SOFT_DPHI_END 1e-9
+static void run_soft(result *r)
+{
+    double t0 = now(), c0 = cpu_seconds();
+    odhs_system *sys = NULL;
+    odhs_softcore *sc = NULL;
+    int d = r->dim;
+    size_t nd = r->n * (size_t)d;
+    double *xs = malloc(nd * sizeof *xs);
+    r->rc = xs ? odhs_system_create(d, r->n, &sys) : ODHS_E_NOMEM;
+    if (!r->rc) r->rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, r->seed);
+    if (!r->rc) r->rc = odhs_system_place_random(sys, d == 2 ? 0.45 : 0.30, r->seed + 1);
+    if (!r->rc) r->rc = odhs_softcore_create(sys, &sc);
+    if (!r->rc) r->rc = odhs_softcore_set_potential(sc, 2.0, 1.0);
+    if (!r->rc) r->rc = odhs_softcore_set_minimiser(sc, ODHS_SOFTCORE_FIRE);
+    if (!r->rc) r->rc = odhs_softcore_set_min_tolerance(sc, SOFT_FTOL, 100000000);
+    double phi = 0.0, dphi = SOFT_DPHI0;
+    if (!r->rc) r->rc = odhs_system_packing_fraction(sys, &phi);
+    r->s_phi_hi = NAN;
+    while (!r->rc && dphi >= SOFT_DPHI_END * phi) {
+        odhs_system_get_positions(sys, xs);
+        double s = pow(phi / (phi + dphi), 1.0 / d), U = 0.0;
+        uint64_t it = 0;
+        if ((r->rc = odhs_softcore_scale_box(sc, s))) break;
+        int m = odhs_softcore_minimise(sc, &it);
+        r->s_mins++;
+        r->s_iters += it;
+        if (m && m != ODHS_E_NOCONV) {
+            r->rc = m;
+            break;
+        }
+        odhs_softcore_energy(sc, &U);
+        if (m == ODHS_E_NOCONV || U / (double)r->n > SOFT_EJAM) {
+            /* jammed (or not relaxed): note it, back to the last unjammed state */
+            r->s_phi_hi = phi + dphi;
+            odhs_softcore_max_overlap(sc, &r->s_overlap);
+            odhs_softcore_coordination(sc, 1, &r->s_z);
+            odhs_softcore_max_force(sc, &r->s_fres);
+            if ((r->rc = odhs_softcore_scale_box(sc, 1.0 / s))) break;
+            if ((r->rc = odhs_softcore_set_positions(sc, xs))) break;
+            dphi *= 0.5;
+        } else {
+            phi += dphi;
+        }
+    }
+    r->s_phi_lo = phi;
+    r->cert.phi = phi;
+    r->certified = 0;
+    r->wall = now() - t0;
+    r->cpu = cpu_seconds() - c0;
+    r->done = 1;
+    odhs_softcore_destroy(sc);
+    odhs_system_destroy(sys);
+    free(xs);
+}
+
 /* the packing itself (runs in the child) */
 static void run_packing(result *r, int f0_check)
 {
+    if (r->soft) {
+        run_soft(r);
+        return;
+    }
     double t0 = now(), c0 = cpu_seconds();
     odhs_system *sys = NULL;
     odhs_solver *sol = NULL;
@@ -267,7 +348,7 @@ static void machine(int workers, double budget)
 #endif
            solver_name, ob ? ob : "(unset)");
     printf("# settings: bidisperse 50:50, radii 0.5/0.7, 3%% polydispersity, RSA at phi 0.45 (2D) / 0.30 (3D),\n"
-           "#   compression rate 1, Euler dt = 1e-3 tau, drift correction every %u step(s), stop at ODHS_JAMMED;\n"
+           "#   compression rate 1, default adaptive integrator, drift correction every %u step(s), stop at ODHS_JAMMED;\n"
            "#   %d packings at a time (one process each), budget %.0f s\n",
            correction, workers, budget);
     if (csv) {
@@ -372,6 +453,8 @@ int main(int argc, char **argv)
     const char *b = getenv("ODHS_BENCH_BUDGET"), *j = getenv("ODHS_BENCH_JOBS"), *fs = getenv("ODHS_BENCH_SOLVER");
     double budget = b ? atof(b) : 1200.0;
     if (!(budget > 0)) budget = 1200.0;
+    const char *sl = getenv("ODHS_BENCH_SOFT_LIMIT");
+    double soft_limit = sl && atof(sl) > 0 ? atof(sl) : 3600.0;
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
     int workers = j ? atoi(j) : (int)(cpus > 0 ? cpus : 1);
     if (workers < 1) workers = 1;
@@ -566,15 +649,67 @@ int main(int argc, char **argv)
     }
     csv_runs("timing", tr, NT);
 
-    /* ---- table 3 ------------------------------------------------------------------ */
-    printf("\n## Table 3: soft-sphere comparison\n");
-    printf("not available: the soft-core (harmonic) module of the library is not written yet, so no\n"
-           "soft-sphere phi_J is computed here; compare with the literature values instead\n"
-           "(2D bidisperse 1.4: phi_J ~ 0.84; 3D: ~ 0.64-0.65).\n");
-    if (csv) {
-        fprintf(csv, "softsphere,,,,,,,,,,,,,,,,,,,,not available: no soft-core module yet\n");
-        fclose(csv);
+    /* ---- table 3: the soft-sphere route on the same starts ------------------------ */
+    struct {
+        int dim;
+        size_t n;
+    } soft_sizes[] = {{2, 256}, {2, 1024}, {3, 128}};
+    enum { NS = sizeof soft_sizes / sizeof soft_sizes[0] };
+    result sr[NS], er[NS];
+    memset(sr, 0, sizeof sr);
+    memset(er, 0, sizeof er);
+    int have_er[NS] = {0};
+    for (int k = 0; k < NS; ++k) {
+        sr[k].dim = er[k].dim = soft_sizes[k].dim;
+        sr[k].n = er[k].n = soft_sizes[k].n;
+        sr[k].seed = er[k].seed = 1;
+        sr[k].soft = 1;
+        /* the event-driven packing of this start, if a table above made it */
+        const result *pools[3] = {st2, st3, tr};
+        size_t np[3] = {N_SEEDS, N_SEEDS, NT};
+        for (int q = 0; q < 3 && !have_er[k]; ++q)
+            for (size_t j = 0; j < np[q]; ++j)
+                if (pools[q][j].dim == er[k].dim && pools[q][j].n == er[k].n && pools[q][j].seed == 1 &&
+                    pools[q][j].done && pools[q][j].wall >= 0) {
+                    er[k] = pools[q][j];
+                    have_er[k] = 1;
+                    break;
+                }
     }
+    fprintf(stderr, "soft-sphere route: %d starts\n", NS);
+    run_pool(sr, NS, workers, INFINITY, soft_limit, 0);
+    for (int k = 0; k < NS; ++k)
+        if (!have_er[k]) run_pool(&er[k], 1, 1, INFINITY, soft_limit, 0);
+    printf("\n## Table 3: soft-sphere route (harmonic, FIRE to max|F| < %.0e, jammed when U/N > %.0e,\n"
+           "##   compression steps from %.0e halved to %.0e relative) against the event-driven packing, same start\n",
+           SOFT_FTOL, SOFT_EJAM, SOFT_DPHI0, SOFT_DPHI_END);
+    printf("%-3s %6s %-13s %9s %9s %14s %14s %10s %10s %10s %8s %12s\n", "d", "N", "route", "seconds", "cpu_s",
+           "phi_J", "phi_J upper", "overlap", "gap", "resid_F", "z_bb", "work");
+    for (int k = 0; k < NS; ++k) {
+        const result *e = &er[k], *q = &sr[k];
+        if (e->done)
+            printf("%-3d %6zu %-13s %9.1f %9.1f %14.10f %14s %10.1e %10.1e %10.1e %8.4f %9llu st\n", e->dim, e->n,
+                   "event-driven", e->wall, e->cpu, e->cert.phi, "(exact)", e->cert.overlap, e->cert.gap_error,
+                   e->cert.force_balance, e->cert.z_backbone, (unsigned long long)e->steps);
+        else
+            printf("%-3d %6zu %-13s killed after %.0f s\n", e->dim, e->n, "event-driven", e->wall);
+        if (q->done && !q->rc)
+            printf("%-3d %6zu %-13s %9.1f %9.1f %14.10f %14.10f %10.1e %10s %10.1e %8.4f %6llu/%llu min/it\n",
+                   q->dim, q->n, "soft-sphere", q->wall, q->cpu, q->s_phi_lo, q->s_phi_hi, q->s_overlap, "-",
+                   q->s_fres, q->s_z, (unsigned long long)q->s_mins, (unsigned long long)q->s_iters);
+        else if (q->done)
+            printf("%-3d %6zu %-13s failed: %d (%s)\n", q->dim, q->n, "soft-sphere", q->rc, odhs_strerror(q->rc));
+        else
+            printf("%-3d %6zu %-13s killed after %.0f s\n", q->dim, q->n, "soft-sphere", q->wall);
+        if (e->done && q->done && !q->rc)
+            printf("    time soft/event-driven %.2f; phi_J difference (soft lower bound - event-driven) %+.2e\n",
+                   q->wall / e->wall, q->s_phi_lo - e->cert.phi);
+        if (csv && q->done)
+            fprintf(csv, "softsphere,%d,%zu,1,,,%.12f,%.12f,,,,%.5f,%.2f,%.2f,%llu,%.3e,,%.3e,,,%s\n", q->dim, q->n,
+                    q->s_phi_lo, q->s_phi_hi, q->s_z, q->wall, q->cpu, (unsigned long long)q->s_iters, q->s_fres,
+                    q->s_overlap, q->rc ? odhs_strerror(q->rc) : "");
+    }
+    if (csv) fclose(csv);
     printf("\n# total %.0f s\n", now() - t_start);
     return 0;
 }
