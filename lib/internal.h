@@ -426,6 +426,7 @@ struct odhs_stepper {
      * with f0 then freg in fpj (2 nc); pj_bordered while net->f is of that form */
     double *fpj;
     size_t fpjcap;
+    uint64_t fpj_version; /* net->version of the f0 in fpj (0: none) */
     int pj_bordered;
     odhs_change *chg;
     size_t nchg, chgcap;

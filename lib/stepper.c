@@ -174,14 +174,6 @@ static void affine_rhs(odhs_stepper *st, double *b)
     }
 }
 
-/* Fixed pressure on a potentially jammed network (d(Nbar - 1) + 1 contacts in
- * the constrained subset): N is singular with the kernel f0, but the volume is
- * one more degree of freedom, so the network is not jammed. N f = b + a r
- * (a = gdot kappa / xi0) has a solution only for a = -<f0|b>/<f0|r>: kappa
- * follows from the geometry. f = freg + alpha f0, with freg solved on the
- * network without the contact k of largest |f0| (its row of S follows from
- * the others through f0, and so does its equation), and alpha sets the
- * pressure. The velocities see freg only (S^T f0 = 0). */
 /* N x = rhs on an isostatic network, rhs orthogonal to its self-stress f0:
  * solved on the network without the contact k of largest |f0|, whose row of
  * S (and equation) follows from the others through f0; x[k] = 0. rhs and x
@@ -205,19 +197,30 @@ static int solve_isostatic(odhs_stepper *st, const double *f0, double *rhs, doub
     return ODHS_OK;
 }
 
-/* f0 of the current (isostatic) network into st->fpj (room for 2 nc) */
+/* f0 of the current (isostatic) network into st->fpj (room for 2 nc), kept
+ * while the network's version is unchanged */
 static int isostatic_f0(odhs_stepper *st)
 {
     odhs_network *net = st->net;
+    if (st->fpj_version == net->version && st->fpjcap >= 2 * net->nc) return ODHS_OK;
     if (reserve((void **)&st->fpj, &st->fpjcap, 2 * net->nc, sizeof *st->fpj))
         return sterr(st, ODHS_E_NOMEM, "out of memory");
     int s = odhs__null_vector(net, st->sol, st->fpj, NULL);
     if (s)
-        return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "fixed pressure, isostatic network: %s",
-                     net->errmsg);
+        return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "isostatic network at t = %.17g: %s",
+                     st->time, net->errmsg);
+    st->fpj_version = net->version;
     return ODHS_OK;
 }
 
+/* Fixed pressure on a potentially jammed network (d(Nbar - 1) + 1 contacts in
+ * the constrained subset): N is singular with the kernel f0, but the volume is
+ * one more degree of freedom, so the network is not jammed. N f = b + a r
+ * (a = gdot kappa / xi0) has a solution only for a = -<f0|b>/<f0|r>: kappa
+ * follows from the geometry. f = freg + alpha f0, with freg solved on the
+ * network without the contact k of largest |f0| (its row of S follows from
+ * the others through f0, and so does its equation), and alpha sets the
+ * pressure. The velocities see freg only (S^T f0 = 0). */
 static int pressure_isostatic_forces(odhs_stepper *st, const double *b)
 {
     odhs_network *net = st->net;
@@ -399,10 +402,15 @@ static int rewire_forces(odhs_stepper *st, int *pj)
                          "fixed pressure at t = %.17g: the self-stress at zero pressure opens no contact", st->time);
         return ODHS_OK;
     }
-    if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
-        return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "potentially jammed at t = %.17g: %s",
-                     st->time, net->errmsg);
-    if (!st->drv->pressure_on) return ODHS_OK;
+    if (!st->drv->pressure_on) {
+        if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
+            return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "potentially jammed at t = %.17g: %s",
+                         st->time, net->errmsg);
+        return ODHS_OK;
+    }
+    /* kept in st->fpj for the forces of the flowing network below */
+    if ((s = isostatic_f0(st))) return s;
+    memcpy(net->f, st->fpj, net->nc * sizeof *net->f);
     double fmax = 0.0;
     for (size_t c = 0; c < net->nc; ++c) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
     for (size_t c = 0; c < net->nc; ++c)
