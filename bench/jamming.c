@@ -12,6 +12,7 @@
  *                       cholmod-pcg, cholmod, spqr, dense that this library
  *                       provides: the sparse ones are the fast ones near
  *                       jamming, where cg stalls and dense costs O(Nc^3))
+ *   ODHS_BENCH_N2, ODHS_BENCH_N3  force the sizes of table 1 (2D, 3D)
  *   ODHS_BENCH_CORRECTION  drift correction every K steps (default 1, as
  *                       examples/jam_packing: the contact gaps must be at
  *                       round-off when the packing jams)
@@ -538,6 +539,10 @@ int main(int argc, char **argv)
         snprintf(skipped + l, sizeof skipped - l, "  3D N = %zu x %d seeds: estimated %.0f s > %.0f s\n", cand3[k],
                  N_SEEDS, est, share);
     }
+    /* sizes forced from the environment (the estimate above is rough) */
+    const char *fn2 = getenv("ODHS_BENCH_N2"), *fn3 = getenv("ODHS_BENCH_N3");
+    if (fn2 && atol(fn2) >= 2) n2 = (size_t)atol(fn2), skipped[0] = '\0';
+    if (fn3 && atol(fn3) >= 2) n3 = (size_t)atol(fn3), skipped[0] = '\0';
     if (skipped[0]) printf("# phi_J statistics: skipped (budget, solver %s%s):\n%s", solver_name,
                            have_cholmod ? "" : ", no CHOLMOD backend", skipped);
 
