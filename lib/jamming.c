@@ -7,7 +7,7 @@
 
 #include "internal.h"
 
-#define DENSE_MAX 600 /* subsets up to this many contacts use LAPACK */
+#define DENSE_MAX 600 /* subsets up to this many contacts use LAPACK (SVD) */
 
 /* contacts whose both particles are in the constrained subset */
 static int subset_contacts(const odhs_network *net, size_t **idx, size_t *m)
@@ -34,52 +34,70 @@ static int subset_contacts(const odhs_network *net, size_t **idx, size_t *m)
     return ODHS_OK;
 }
 
-/* smallest eigenvector of N restricted to the contacts idx[0..m-1], or of
- * N + r r^T with rv[a] = r of contact idx[a] (rv not NULL): the kernel of S^T
- * with the volume as one more column of S (fixed pressure) */
+/* The kernel vector of S^T restricted to the contacts idx[0..m-1] (with the
+ * extra row r^T, rv[a] = r of contact idx[a], when rv is not NULL: the
+ * volume as one more column of S under fixed pressure), from the SVD of that
+ * dense matrix (LAPACK dgesvd): the right singular vector of the smallest
+ * singular value. Working on S^T itself, not on N = S S^T, keeps the
+ * accuracy at eps sigma_max / sigma_2 instead of its square. The kernel must
+ * be one-dimensional: the next singular value clearly > 0 (columns of S^T
+ * have norm sqrt 2, so singular values are O(1) scaled). */
 static int null_dense(const odhs_network *net, const size_t *idx, size_t m, const double *rv, double *y)
 {
     int d = net->dim;
-    double *A = odhs__calloc(m * m, sizeof *A);
-    double *z = odhs__malloc_array(2 * m, sizeof *z);
-    double *w = odhs__malloc_array(m, sizeof *w); /* dsyevr uses all m entries */
-    lapack_int *supp = odhs__malloc_array(4, sizeof *supp);
-    if (!A || !z || !w || !supp) {
-        odhs__free(A);
-        odhs__free(z);
-        odhs__free(w);
-        odhs__free(supp);
-        return ODHS_E_NOMEM;
+    size_t n = net->n, nr = 0;
+    size_t *row = odhs__malloc_array(n ? n : 1, sizeof *row);
+    if (!row) return ODHS_E_NOMEM;
+    for (size_t i = 0; i < n; ++i) row[i] = SIZE_MAX;
+    for (size_t a = 0; a < m; ++a) {
+        size_t c = idx[a];
+        if (row[net->ci[c]] == SIZE_MAX) row[net->ci[c]] = nr++;
+        if (net->cj[c] < n && row[net->cj[c]] == SIZE_MAX) row[net->cj[c]] = nr++;
     }
-    /* N_ab = s_a . s_b: nonzero when contacts a and b share a particle */
-    for (size_t a = 0; a < m; ++a)
-        for (size_t b = a; b < m; ++b) {
-            size_t ca = idx[a], cb = idx[b];
-            double v = 0.0;
-            const double *na = net->nrm + ca * d, *nb = net->nrm + cb * d;
-            double dot = 0.0;
-            for (int k = 0; k < d; ++k) dot += na[k] * nb[k];
-            if (net->ci[ca] == net->ci[cb]) v += dot;
-            if (net->cj[ca] == net->cj[cb] && net->cj[ca] < net->n) v += dot; /* walls have no block */
-            if (net->ci[ca] == net->cj[cb]) v -= dot;
-            if (net->cj[ca] == net->ci[cb]) v -= dot;
-            if (rv) v += rv[a] * rv[b];
-            A[b * m + a] = v; /* (row a, column b), a <= b: upper triangle, column-major */
-        }
-    lapack_int found = 0;
-    lapack_int mm = (lapack_int)m, iu = m >= 2 ? 2 : 1;
-    lapack_int info = LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'U', mm, A, mm, 0.0, 0.0, 1, iu, 0.0, &found,
-                                     w, z, mm, supp);
+    size_t R = nr * (size_t)d + (rv ? 1 : 0), ns = R < m ? R : m;
+    double *A = odhs__calloc(R * m + 1, sizeof *A);
+    double *vt = odhs__malloc_array(m * m + 1, sizeof *vt);
+    double *sv = odhs__malloc_array(ns + 1, sizeof *sv);
+    double *sup = odhs__malloc_array(ns + 1, sizeof *sup);
     int st = ODHS_OK;
-    if (info != 0 || found < 1) st = ODHS_E_INTERNAL;
-    /* the kernel must be one-dimensional: the second eigenvalue clearly > 0
-     * (the diagonal of N is 2, so eigenvalues are O(1) scaled) */
-    else if (found >= 2 && !(w[1] > 1e-9)) st = ODHS_E_SINGULAR;
-    else memcpy(y, z, m * sizeof *y);
+    if (!A || !vt || !sv || !sup) {
+        st = ODHS_E_NOMEM;
+        goto done;
+    }
+    /* column a = s_a^T: -n on i's rows, +n on j's (a wall has no block) */
+    for (size_t a = 0; a < m; ++a) {
+        size_t c = idx[a];
+        const double *nc = net->nrm + c * d;
+        for (int k = 0; k < d; ++k) {
+            A[a * R + row[net->ci[c]] * d + k] = -nc[k];
+            if (net->cj[c] < n) A[a * R + row[net->cj[c]] * d + k] = nc[k];
+        }
+        if (rv) A[a * R + R - 1] = rv[a];
+    }
+    if (m < 2 || m > R + 1) {
+        st = ODHS_E_SINGULAR; /* no kernel, or more than a one-dimensional one */
+        goto done;
+    }
+    lapack_int info = LAPACKE_dgesvd(LAPACK_COL_MAJOR, 'N', 'A', (lapack_int)R, (lapack_int)m, A, (lapack_int)R, sv,
+                                     NULL, 1, vt, (lapack_int)m, sup);
+    if (info != 0) {
+        st = ODHS_E_INTERNAL;
+        goto done;
+    }
+    /* the next-smallest singular value: sv[m-2] when the smallest, sv[m-1],
+     * is the kernel's; sv[R-1] when m = R + 1 (the kernel is not in sv) */
+    double next = m <= R ? sv[m - 2] : sv[R - 1];
+    if (!(next * next > 1e-9)) {
+        st = ODHS_E_SINGULAR;
+        goto done;
+    }
+    for (size_t a = 0; a < m; ++a) y[a] = vt[a * m + (m - 1)]; /* row m-1 of V^T */
+done:
+    odhs__free(row);
     odhs__free(A);
-    odhs__free(z);
-    odhs__free(w);
-    odhs__free(supp);
+    odhs__free(vt);
+    odhs__free(sv);
+    odhs__free(sup);
     return st;
 }
 
