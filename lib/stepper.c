@@ -386,6 +386,7 @@ static int rewire_forces(odhs_stepper *st, int *pj)
          * diverge along the self-stress fs at zero pressure, with the sign
          * that resists the driving (<fs|b> > 0); its most negative contact
          * opens (fs has both signs, since <fs|r> = 0) */
+        st->work_pressure++;
         if ((s = reserve_contacts(st, net->nc))) return sterr(st, s, "out of memory");
         affine_rhs(st, st->cb);
         if ((s = odhs__null_vector_volume(net, st->sol, net->f)))
@@ -1143,6 +1144,7 @@ static int correct_isostatic(odhs_stepper *st, double *Z)
     odhs_network *net = st->net;
     size_t nc = net->nc;
     int s;
+    st->work_pressure++;
     if ((s = isostatic_f0(st))) return s;
     double *f0 = st->fpj, *rhs = st->fpj + nc;
     double fg = 0.0, fr = 0.0;
