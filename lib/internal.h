@@ -307,8 +307,9 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
 int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);
 /* fixed pressure: the kernel vector fs of S^T with <r|fs> = 0 (the volume as
  * one more column of S) on a constrained subset with d(Nbar - 1) + 2
- * contacts, max |fs| = 1, sign undetermined (lib/jamming.c) */
-int odhs__null_vector_volume(const odhs_network *net, odhs_solver *solver, double *fs);
+ * contacts, max |fs| = 1, sign undetermined; by the SVD of that matrix
+ * (lib/jamming.c) */
+int odhs__null_vector_volume(const odhs_network *net, double *fs);
 /* *excess = constraints in the constrained subset minus its degrees of
  * freedom: 1 for an isostatic subset (potentially jammed), 2 with one more
  * contact; LONG_MIN for an empty subset */

@@ -124,30 +124,34 @@ fail:
     return NULL;
 }
 
-/* fix f0 at contact idx[kk] to 1, least squares for the others */
-static int null_sparse(const odhs_network *net, odhs_solver *solver, const size_t *idx, size_t m, size_t kk,
-                       double *y)
+/* f0 fixed to 1 on contact idx[k1], least squares S'^T x = -s_k1^T for the
+ * others on sub, the network of idx without k1; g (n d) and x (m) are
+ * scratch */
+static int kernel_fixed(const odhs_network *net, odhs_solver *solver, odhs_network *sub, const size_t *idx,
+                        size_t m, size_t k1, double *g, double *x, double *y)
 {
     int d = net->dim;
-    odhs_network *sub = odhs__net_subnet(net, idx, m, kk);
-    double *g = odhs__calloc(net->n * (size_t)d, sizeof *g);
-    double *x = odhs__calloc(m, sizeof *x);
-    int st = ODHS_OK;
-    if (!sub || !g || !x) {
-        st = ODHS_E_NOMEM;
-        goto done;
-    }
-    /* S'^T y = -s_k^T: s_k has -n on i and +n on j */
-    size_t ck = idx[kk];
+    size_t ck = idx[k1];
+    memset(g, 0, net->n * (size_t)d * sizeof *g);
     for (int k = 0; k < d; ++k) {
         g[net->ci[ck] * d + k] = net->nrm[ck * d + k];
         if (net->cj[ck] < net->n) g[net->cj[ck] * d + k] = -net->nrm[ck * d + k];
     }
-    st = odhs_solver_solve_ls(solver, sub, g, x);
-    if (st) goto done;
-    /* sub's contacts are in the order added: idx without kk */
-    for (size_t a = 0, s = 0; a < m; ++a) y[a] = a == kk ? 1.0 : x[s++];
-done:
+    int st = odhs_solver_solve_ls(solver, sub, g, x);
+    if (st) return st;
+    /* sub's contacts are in the order added: idx without k1 */
+    for (size_t a = 0, q = 0; a < m; ++a) y[a] = a == k1 ? 1.0 : x[q++];
+    return ODHS_OK;
+}
+
+/* fix f0 at contact idx[kk] to 1, least squares for the others */
+static int null_sparse(const odhs_network *net, odhs_solver *solver, const size_t *idx, size_t m, size_t kk,
+                       double *y)
+{
+    odhs_network *sub = odhs__net_subnet(net, idx, m, kk);
+    double *g = odhs__calloc(net->n * (size_t)net->dim, sizeof *g);
+    double *x = odhs__calloc(m, sizeof *x);
+    int st = sub && g && x ? kernel_fixed(net, solver, sub, idx, m, kk, g, x, y) : ODHS_E_NOMEM;
     odhs_network_destroy(sub);
     odhs__free(g);
     odhs__free(x);
@@ -217,37 +221,16 @@ done:
     return st;
 }
 
-/* f0 fixed to 1 on contact idx[k1] and 0 on idx[k2], least squares for the
- * others: a vector of a two-dimensional kernel of S^T (sub is the network of
- * idx without k1 and k2) */
-static int kernel_fixed(const odhs_network *net, odhs_solver *solver, odhs_network *sub, const size_t *idx,
-                        size_t m, size_t k1, size_t k2, double *g, double *x, double *y)
-{
-    int d = net->dim;
-    size_t ck = idx[k1];
-    memset(g, 0, net->n * (size_t)d * sizeof *g);
-    for (int k = 0; k < d; ++k) {
-        g[net->ci[ck] * d + k] = net->nrm[ck * d + k];
-        if (net->cj[ck] < net->n) g[net->cj[ck] * d + k] = -net->nrm[ck * d + k];
-    }
-    int st = odhs_solver_solve_ls(solver, sub, g, x);
-    if (st) return st;
-    for (size_t a = 0, q = 0; a < m; ++a) y[a] = a == k1 ? 1.0 : a == k2 ? 0.0 : x[q++];
-    return ODHS_OK;
-}
-
-int odhs__null_vector_volume(const odhs_network *net, odhs_solver *solver, double *fs)
+int odhs__null_vector_volume(const odhs_network *net, double *fs)
 {
     size_t *idx = NULL, m = 0;
     int st = subset_contacts(net, &idx, &m);
     if (st) return odhs__neterr(net, st, "out of memory");
-    double *y = odhs__malloc_array(2 * m + 1, sizeof *y);
+    double *y = odhs__malloc_array(m + 1, sizeof *y);
     double *rv = odhs__malloc_array(m + 1, sizeof *rv);
     double *F = odhs__malloc_array(net->n * (size_t)net->dim, sizeof *F);
     double *full = odhs__calloc(net->nc + 1, sizeof *full);
-    double *x = odhs__calloc(m + 1, sizeof *x);
-    odhs_network *sub = NULL;
-    if (!y || !rv || !F || !full || !x) {
+    if (!y || !rv || !F || !full) {
         st = odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
         goto done;
     }
@@ -256,34 +239,10 @@ int odhs__null_vector_volume(const odhs_network *net, odhs_solver *solver, doubl
         st = odhs__neterr(net, ODHS_E_STATE, "too few contacts for a self-stress at zero pressure");
         goto done;
     }
-    if (!solver || m <= DENSE_MAX) {
-        st = null_dense(net, idx, m, rv, y);
-    } else {
-        /* two kernel vectors of S^T, from the network without the two most
-         * recently added contacts, then the combination without pressure */
-        size_t k1 = m - 1, k2 = m - 2;
-        size_t keep[2] = {k1 < k2 ? k1 : k2, k1 < k2 ? k2 : k1};
-        size_t *rest = odhs__malloc_array(m, sizeof *rest), q = 0;
-        if (!rest) {
-            st = ODHS_E_NOMEM;
-        } else {
-            for (size_t a = 0; a < m; ++a)
-                if (a != keep[0] && a != keep[1]) rest[q++] = idx[a];
-            sub = odhs__net_subnet(net, rest, q, SIZE_MAX);
-            odhs__free(rest);
-            if (!sub) st = ODHS_E_NOMEM;
-        }
-        if (!st) st = kernel_fixed(net, solver, sub, idx, m, k1, k2, F, x, y);
-        if (!st) st = kernel_fixed(net, solver, sub, idx, m, k2, k1, F, x, y + m);
-        if (!st) {
-            double r1 = 0.0, r2 = 0.0;
-            for (size_t a = 0; a < m; ++a) {
-                r1 += rv[a] * y[a];
-                r2 += rv[a] * y[m + a];
-            }
-            for (size_t a = 0; a < m; ++a) y[a] = r2 * y[a] - r1 * y[m + a];
-        }
-    }
+    /* always the SVD: this case (one contact above isostatic under fixed
+     * pressure) is rare, and a solver route would need two contacts whose
+     * removal leaves a full-rank network, which the newest ones need not be */
+    st = null_dense(net, idx, m, rv, y);
     if (st) {
         st = odhs__neterr(net, st == ODHS_E_NOMEM ? st : ODHS_E_SINGULAR, "self-stress at zero pressure: %s",
                           odhs_strerror(st));
@@ -311,13 +270,11 @@ int odhs__null_vector_volume(const odhs_network *net, odhs_solver *solver, doubl
     }
     memcpy(fs, full, net->nc * sizeof *fs);
 done:
-    odhs_network_destroy(sub);
     odhs__free(idx);
     odhs__free(y);
     odhs__free(rv);
     odhs__free(F);
     odhs__free(full);
-    odhs__free(x);
     return st;
 }
 

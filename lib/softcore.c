@@ -638,10 +638,12 @@ int odhs_softcore_scale_box(odhs_softcore *sc, double s)
     if (!isfinite(s)) return scerr(sc, ODHS_E_NONFINITE, "scale factor is not finite");
     if (!(s > 0.0)) return scerr(sc, ODHS_E_INVALID, "scale factor %g must be > 0", s);
     odhs_system *sys = sc->sys;
-    for (int k = 0; k < sc->dim; ++k)
-        if (!(s * sys->L[k] >= 4.0 * sys->rmax) || !isfinite(s * sys->L[k]))
+    for (int k = 0; k < sc->dim; ++k) {
+        if (!isfinite(s * sys->L[k])) return scerr(sc, ODHS_E_NONFINITE, "box edge %d would overflow", k);
+        if (!(s * sys->L[k] >= 4.0 * sys->rmax))
             return scerr(sc, ODHS_E_BOX, "box edge %d would be %g, shorter than twice the largest diameter %g", k,
-                         s * sys->L[k], 2.0 * (2.0 * sys->rmax));
+                         s * sys->L[k], 4.0 * sys->rmax);
+    }
     for (int k = 0; k < sc->dim; ++k) sys->L[k] *= s;
     for (size_t q = 0; q < sc->nd; ++q) sys->x[q] *= s;
     wrap_all(sc, sys->x);

@@ -389,7 +389,7 @@ static int rewire_forces(odhs_stepper *st, int *pj)
         st->work_pressure++;
         if ((s = reserve_contacts(st, net->nc))) return sterr(st, s, "out of memory");
         affine_rhs(st, st->cb);
-        if ((s = odhs__null_vector_volume(net, st->sol, net->f)))
+        if ((s = odhs__null_vector_volume(net, net->f)))
             return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "fixed pressure at t = %.17g: %s",
                          st->time, net->errmsg);
         double fb = 0.0, fmin = 0.0;

@@ -1971,6 +1971,7 @@ static int huge_rate_case(void)
     X(sc_scale_neg, odhs_softcore_scale_box, ODHS_E_INVALID, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, -0.5));) \
     X(sc_scale_nan, odhs_softcore_scale_box, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, NAN_));) \
     X(sc_scale_inf, odhs_softcore_scale_box, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, 1.0 / 0.0));) \
+    X(sc_scale_huge, odhs_softcore_scale_box, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, 1e308));) \
     X(sc_scale_tiny, odhs_softcore_scale_box, ODHS_E_BOX, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_scale_box(sc, 1e-3));) \
     X(sc_vel_nullu, odhs_softcore_set_velocities, ODHS_E_NULL, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_set_velocities(sc, NULL));) \
     X(sc_vel_nan, odhs_softcore_set_velocities, ODHS_E_NONFINITE, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_vel_nan(sc));) \

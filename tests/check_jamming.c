@@ -1276,6 +1276,33 @@ static void tiled_network(const jrun *r, int bars_first, odhs_system **big_out, 
     *net_out = net;
 }
 
+/* the internal zero-pressure self-stress (lib/jamming.c; the runner links
+ * the static library) */
+int odhs__null_vector_volume(const odhs_network *net, double *fs);
+
+/* the first pair of backbone discs of one copy, not in contact and not in
+ * the network */
+typedef struct {
+    const odhs_network *net;
+    size_t n;
+    unsigned char *in;
+    int found;
+    size_t i, j;
+} extra_ctx;
+
+static int extra_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    extra_ctx *e = vctx;
+    size_t k;
+    if (i / e->n != j / e->n || gap < 0.05 || !e->in[i % e->n] || !e->in[j % e->n]) return 0;
+    if (odhs_network_find(e->net, i, j, &k) != ODHS_OK || k != SIZE_MAX) return 0;
+    e->found = 1;
+    e->i = i;
+    e->j = j;
+    return 1;
+}
+
 START_TEST(test_null_vector_large)
 {
     jrun r;
@@ -1377,6 +1404,61 @@ START_TEST(test_null_vector_large)
                          names[s], ex, res);
             }
             odhs_solver_destroy(sol);
+        }
+        if (order == 1) {
+            /* one more pair (backbone discs of one copy, not in contact):
+             * d(Nbar - 1) + 2 contacts, the fixed-pressure case, with more
+             * than 600 contacts. The self-stress at zero pressure (kernel of
+             * S^T with the row r^T, by the SVD) must be one: S^T fs = 0 and
+             * <r|fs> = 0, checked with own sums. */
+            odhs_network *net2 = net;
+            extra_ctx ex;
+            memset(&ex, 0, sizeof ex);
+            ex.net = net2;
+            ex.n = r.n;
+            ex.in = xcalloc(r.n, 1);
+            CHECK_OK(odhs_network_constrained(odhs_stepper_network(r.st), NULL, NULL, ex.in, NULL));
+            odhs_system_for_each_pair(big, 0.6, extra_cb, &ex);
+            ck_assert_msg(ex.found, "no extra pair");
+            CHECK_OK(odhs_network_add(net2, ex.i, ex.j, ODHS_CONTACT_TEMPORARY));
+            CHECK_OK(odhs_network_update_geometry(net2, big));
+            size_t m2 = odhs_network_count(net2);
+            double *va = xcalloc(m2, sizeof *va);
+            int ra = odhs__null_vector_volume(net2, va);
+            ck_assert_msg(ra == ODHS_OK, "zero-pressure self-stress: %d (%s)", ra, odhs_network_errmsg(net2));
+            double fr = 0.0, frs = 0.0, big_f = 0.0;
+            for (size_t k = 0; k < m2; ++k) big_f = fmax(big_f, fabs(va[k]));
+            double *gap2 = xcalloc(m2, sizeof *gap2), *nrm2 = xcalloc(2 * m2, sizeof *nrm2);
+            double *F2 = xcalloc(2 * 4 * r.n, sizeof *F2), *rad2 = xcalloc(4 * r.n, sizeof *rad2);
+            CHECK_OK(odhs_network_get_gaps(net2, gap2));
+            CHECK_OK(odhs_network_get_normals(net2, nrm2));
+            CHECK_OK(odhs_system_get_radii(big, rad2));
+            for (size_t k = 0; k < m2; ++k) {
+                size_t P, Q;
+                CHECK_OK(odhs_network_get_contact(net2, k, &P, &Q, NULL));
+                fr += va[k] * (gap2[k] + rad2[P] + rad2[Q]);
+                frs += fabs(va[k]);
+                for (int q = 0; q < 2; ++q) {
+                    F2[P * 2 + q] -= va[k] * nrm2[k * 2 + q];
+                    F2[Q * 2 + q] += va[k] * nrm2[k * 2 + q];
+                }
+            }
+            double fb = 0.0;
+            for (size_t k = 0; k < 2 * 4 * r.n; ++k) fb = fmax(fb, fabs(F2[k]));
+            if (getenv("ODHS_TEST_VERBOSE"))
+                fprintf(stderr, "large: zero-pressure self-stress, %zu contacts: max |fs| %.3e, S^T fs %.3e, <r|fs> %.3e\n",
+                        m2, big_f, fb, fr / frs);
+            if (!(fabs(big_f - 1.0) < 1e-15) || !(fb < 1e-10) || !(fabs(fr) < 1e-10 * frs)) {
+                size_t l = strlen(fails);
+                snprintf(fails + l, sizeof fails - l, "zero-pressure self-stress: max %.3e, S^T fs %.3e, <r|fs> %.3e; ",
+                         big_f, fb, fr / frs);
+            }
+            free(va);
+            free(gap2);
+            free(nrm2);
+            free(F2);
+            free(rad2);
+            free(ex.in);
         }
         free(fe);
         free(fl);

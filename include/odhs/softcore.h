@@ -179,9 +179,9 @@ ODHS_API int odhs_softcore_set_positions(odhs_softcore *sc, const double *x);
  * isotropic compression (s < 1) or dilation (s > 1) that, unlike
  * odhs_system_scale_box, may create overlaps (soft-sphere jamming protocols
  * compress and minimise). The strain, radii and velocities are kept.
- * Errors: ODHS_E_NULL, ODHS_E_NONFINITE, ODHS_E_INVALID (s <= 0), ODHS_E_BOX
- * (an edge would be shorter than twice the largest diameter); the system is
- * then unchanged. (Since 0.2.1.)
+ * Errors: ODHS_E_NULL, ODHS_E_NONFINITE (s or a scaled edge not finite),
+ * ODHS_E_INVALID (s <= 0), ODHS_E_BOX (an edge would be shorter than twice the
+ * largest diameter); the system is then unchanged. (Since 0.2.1.)
  */
 ODHS_API int odhs_softcore_scale_box(odhs_softcore *sc, double s);
 /** Set the non-affine velocities u[0..n*dim-1] (massive models; the
