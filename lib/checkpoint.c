@@ -97,7 +97,10 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
     put(&b, MAGIC, 8);
     /* version 1 unless a section of version 2 is needed, so that files
      * without them stay readable by older releases */
-    put_u64(&b, drv->prop_on || drv->grav_on || net->nwalls || net->nperm || net->rbody ? 2u : 1u);
+    /* the driver changed after the forces were solved: the next step
+     * re-solves them first (section DRVC, since 0.2.2) */
+    int stale = st->drv_version != drv->version;
+    put_u64(&b, drv->prop_on || drv->grav_on || net->nwalls || net->nperm || net->rbody || stale ? 2u : 1u);
     /* system */
     put_tag(&b, "SYS ");
     put_u64(&b, (uint64_t)sys->dim);
@@ -207,6 +210,10 @@ int odhs_checkpoint_write(const odhs_stepper *st, const char *path)
         put_f64s(&b, drv->g, 3);
         put_u64(&b, drv->gw ? drv->gwn : 0u);
         if (drv->gw) put_f64s(&b, drv->gw, drv->gwn);
+    }
+    if (stale) {
+        put_tag(&b, "DRVC");
+        put_u64(&b, 1u);
     }
     put_tag(&b, "END ");
     put_u64(&b, b.nomem ? 0 : fnv1a(b.p, b.len));
@@ -561,6 +568,7 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
         }
     }
     /* optional sections of version 2, each at most once, in any order */
+    int drv_changed = 0;
     while (version >= 2 && b.pos < b.len && !b.bad) {
         char t4[4];
         get(&b, t4, 4);
@@ -603,6 +611,9 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
                 if ((s = odhs_driver_set_gravity_weights(drv, (size_t)nw, tmpF)))
                     FAIL(s, "checkpoint: %s", odhs_strerror(s));
             }
+        } else if (!memcmp(t4, "DRVC", 4) && !drv_changed) {
+            if (get_u64(&b) != 1u || b.bad) FAIL(ODHS_E_FORMAT, "checkpoint: driver-change section malformed");
+            drv_changed = 1;
         } else {
             FAIL(ODHS_E_FORMAT, "checkpoint: unknown or repeated section");
         }
@@ -627,7 +638,9 @@ int odhs_checkpoint_parse(const void *buf, size_t len, odhs_solver *solver, odhs
     }
     /* the forces as eval_forces computes them (a mismatch fails the next step) */
     odhs__driver_extra_forces(drv, sys, st->F, &st->has_F);
-    st->drv_version = drv->version;
+    /* a driver changed after the last solve is re-solved by the next step,
+     * as it would have been without the checkpoint */
+    st->drv_version = drv_changed ? drv->version - 1 : drv->version;
     st->ready = 1;
     odhs__free(tmpF);
     *sys_out = sys;

@@ -271,6 +271,8 @@ void odhs__net_N(const odhs_network *net, const double *x, double *out, double *
 /* restored stepper: mark the neighbour list stale unless it holds every pair
  * closer than the unused skin (lib/stepper.c); ODHS_OK or ODHS_E_NOMEM */
 int odhs__stepper_check_neighbours(odhs_stepper *st);
+/* tests: 1 = always the anti-cycling rewiring, 0 = the paper's rule first */
+int odhs__stepper_set_rewire_mode(odhs_stepper *st, int mode);
 
 /* ---- solver handle ----------------------------------------------------------- */
 struct odhs_solver {
@@ -423,6 +425,8 @@ struct odhs_stepper {
     /* rewiring */
     odhs_change *rem; /* pairs removed during the current rewiring */
     size_t nrem, remcap;
+    int rewire_mode;            /* 0: paper's rule, anti-cycling takeover; 1: anti-cycling only (tests) */
+    uint64_t nrewire_monotone;  /* rewirings the anti-cycling method finished (not checkpointed) */
     /* fixed pressure on a potentially jammed network: net->f = freg + alpha f0
      * with f0 then freg in fpj (2 nc); pj_bordered while net->f is of that form */
     double *fpj;

@@ -422,17 +422,193 @@ static int rewire_forces(odhs_stepper *st, int *pj)
     return ODHS_OK;
 }
 
+/* The end of a rewiring on a jammed network (positive self-stress): polish
+ * the contacts to round-off, recompute f0 on the final geometry and scale it
+ * to unit pressure; nothing can move under this driving. */
+static int jam_finish(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    int s;
+    if ((s = odhs__jam_polish(st->sys, net, st->sol, net->f)))
+        return sterr(st, s, "polishing the jammed packing: %s", odhs_strerror(s));
+    if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
+        return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "jammed packing: %s", net->errmsg);
+    double fr = 0.0, vol;
+    for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
+    odhs_system_volume(st->sys, &vol);
+    double scale = vol * st->dim / fr;
+    for (size_t c = 0; c < net->nc; ++c) net->f[c] *= scale;
+    memset(st->U, 0, st->nd * sizeof *st->U);
+    st->jammed = 1;
+    return ODHS_OK;
+}
+
+/* Open contact k: into the removed pairs, out of the network (the last
+ * contact takes its place, in net->f and, when given, in x). */
+static int open_contact(odhs_stepper *st, size_t k, double *x)
+{
+    odhs_network *net = st->net;
+    size_t i = net->ci[k], j = net->cj[k];
+    if (reserve((void **)&st->rem, &st->remcap, st->nrem + 1, sizeof *st->rem))
+        return sterr(st, ODHS_E_NOMEM, "out of memory");
+    st->rem[st->nrem].i = i;
+    st->rem[st->nrem].j = j;
+    st->nrem++;
+    if (x) x[k] = x[net->nc - 1];
+    odhs__net_remove_at(net, k);
+    if (record_change(st, i, j, -1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
+    return ODHS_OK;
+}
+
+/* Re-connect the most approaching removed pair (velocities computed on the
+ * current network); *added = 0 when none approaches. The new contact is the
+ * network's last, with force 0. */
+static int close_pair(odhs_stepper *st, int *added)
+{
+    odhs_network *net = st->net;
+    *added = 0;
+    if (st->nrem == 0) return ODHS_OK;
+    double vs = velocity_scale(st), vmin = 0.0;
+    size_t rmin = SIZE_MAX;
+    for (size_t q = 0; q < st->nrem; ++q) {
+        double v = pair_velocity(st, st->rem[q].i, st->rem[q].j);
+        if (v < vmin) {
+            vmin = v;
+            rmin = q;
+        }
+    }
+    if (rmin == SIZE_MAX || vmin >= -EPS_V * vs) return ODHS_OK;
+    size_t i = st->rem[rmin].i, j = st->rem[rmin].j;
+    st->rem[rmin] = st->rem[st->nrem - 1];
+    st->nrem--;
+    size_t c = odhs__net_add(net, i, j, ODHS_CONTACT_TEMPORARY);
+    if (c == SIZE_MAX || record_change(st, i, j, +1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
+    contact_geometry(st, c);
+    *added = 1;
+    return ODHS_OK;
+}
+
+/* Anti-cycling rewiring. The rewiring solves a linear complementarity
+ * problem: forces f >= 0 on the candidate pairs (the network and the pairs
+ * removed so far), gap rates xi0 (N f - b) >= 0, one of the two zero on every
+ * pair. With N = S S^T positive semidefinite these are the optimality
+ * conditions of the convex quadratic programme min 1/2 f.N f - b.f over
+ * f >= 0 (under fixed pressure also r.f = p V d, whose multiplier is the
+ * compression rate). Sect. IV B's rule (drop the most negative force) can
+ * cycle on degenerate, nearly jammed networks; the active-set method of
+ * Lawson and Hanson cannot: it keeps a feasible x, moves it towards the
+ * solution z on the current network only as far as x stays >= 0, opens the
+ * contact that blocks the move, and adds the most approaching pair only at
+ * a solution, so the objective decreases from one network to the next and
+ * no network repeats. A potentially jammed network has no solution but a
+ * direction of descent: its self-stress f0, signed so that b.f0 > 0 (under
+ * fixed pressure the zero-pressure self-stress); a positive f0 is jamming,
+ * as in Sect. IV D. The stopping tests are those of the paper's rule. */
+static int rewire_monotone(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    odhs_driver *drv = st->drv;
+    int s = ODHS_OK;
+    size_t ncand = net->nc + st->nrem, maxit = 20 * (ncand + 16) + 1000;
+    double *x = odhs__calloc(ncand + 1, sizeof *x);
+    if (!x) return sterr(st, ODHS_E_NOMEM, "out of memory");
+    st->nrewire_monotone++;
+    if (drv->pressure_on && net->nc) {
+        /* a feasible start: the pressure on the longest contact alone */
+        double vol;
+        size_t k = 0;
+        odhs_system_volume(st->sys, &vol);
+        for (size_t c = 1; c < net->nc; ++c)
+            if (net->dist[c] > net->dist[k]) k = c;
+        x[k] = drv->p * vol * st->dim / net->dist[k];
+    }
+    for (size_t it = 0;; ++it) {
+        if (it > maxit) {
+            s = sterr(st, ODHS_E_REWIRE, "anti-cycling rewiring did not terminate after %zu iterations", maxit);
+            break;
+        }
+        int pj = 0;
+        if ((s = rewire_forces(st, &pj))) break;
+        size_t nc = net->nc;
+        double *z = net->f, zmax = 0.0, xmax = 0.0;
+        for (size_t c = 0; c < nc; ++c) {
+            zmax = fmax(zmax, fabs(z[c]));
+            xmax = fmax(xmax, fabs(x[c]));
+        }
+        int neg = 0;
+        for (size_t c = 0; c < nc && !neg; ++c) neg = odhs__can_open(net->kind[c]) && z[c] < -EPS_F * zmax;
+        if (pj && !neg) {
+            s = jam_finish(st);
+            break;
+        }
+        if (!neg) {
+            /* a solution on this network: the new feasible point */
+            for (size_t c = 0; c < nc; ++c) x[c] = odhs__can_open(net->kind[c]) ? fmax(z[c], 0.0) : z[c];
+            compute_velocities(st);
+            int added = 0;
+            if ((s = close_pair(st, &added)) || !added) break;
+            x[net->nc - 1] = 0.0;
+            continue;
+        }
+        if (pj && !drv->pressure_on) {
+            /* descend along f0: b.f0 > 0 */
+            if ((s = reserve_contacts(st, nc))) {
+                s = sterr(st, s, "out of memory");
+                break;
+            }
+            affine_rhs(st, st->cb);
+            double bz = 0.0;
+            for (size_t c = 0; c < nc; ++c) bz += st->cb[c] * z[c];
+            if (bz < 0.0)
+                for (size_t c = 0; c < nc; ++c) z[c] = -z[c];
+        }
+        /* the step x -> x + t d, d = z - x (a solution) or z (a direction),
+         * up to the first openable contact that reaches zero */
+        double t = INFINITY;
+        size_t kb = SIZE_MAX;
+        for (size_t c = 0; c < nc; ++c) {
+            double d = pj ? z[c] : z[c] - x[c];
+            if (!odhs__can_open(net->kind[c]) || !(z[c] < -EPS_F * zmax) || !(d < 0.0)) continue;
+            double tc = fmax(x[c], 0.0) / -d;
+            if (tc < t) {
+                t = tc;
+                kb = c;
+            }
+        }
+        if (kb == SIZE_MAX) { /* z < 0 only where d >= 0: x = 0 there, open them */
+            t = 0.0;
+            for (size_t c = 0; c < nc && kb == SIZE_MAX; ++c)
+                if (odhs__can_open(net->kind[c]) && z[c] < -EPS_F * zmax) kb = c;
+        }
+        if (!pj && t > 1.0) t = 1.0;
+        for (size_t c = 0; c < nc; ++c) x[c] += t * (pj ? z[c] : z[c] - x[c]);
+        x[kb] = 0.0;
+        /* open the blocking contact and every other one that the step
+         * brought to zero and that the solution pulls further down */
+        double xtol = EPS_F * fmax(xmax, zmax);
+        for (size_t c = nc; c-- > 0;)
+            if (c == kb || (odhs__can_open(net->kind[c]) && z[c] < -EPS_F * zmax && x[c] <= xtol))
+                if ((s = open_contact(st, c, x))) goto done;
+    }
+done:
+    free(x);
+    return s;
+}
+
 /* Rewiring (Sect. IV B): remove the most negative force until none is left,
- * then re-connect the most approaching removed pair, and repeat. */
+ * then re-connect the most approaching removed pair, and repeat. The rule
+ * can cycle near jamming: after a bounded number of iterations (or always,
+ * st->rewire_mode == 1) the anti-cycling method above takes over from the
+ * network reached so far. */
 static int rewire(odhs_stepper *st)
 {
     odhs_network *net = st->net;
     int s;
     st->nrem = 0;
-    size_t maxit = 4 * (net->nc + 16) + 200, it = 0;
+    if (st->rewire_mode == 1) return rewire_monotone(st);
+    size_t maxit = 2 * (net->nc + 16) + 100, it = 0;
     for (;;) {
-        if (++it > maxit)
-            return sterr(st, ODHS_E_REWIRE, "rewiring did not terminate after %zu iterations", maxit);
+        if (++it > maxit) return rewire_monotone(st);
         /* Sect. IV D: on a potentially jammed network N is singular and the
          * self-stress f0 plays the part of the forces */
         int pj = 0;
@@ -447,54 +623,14 @@ static int rewire(odhs_stepper *st)
             }
         }
         if (kmin != SIZE_MAX && fmin < -EPS_F * fmax) {
-            size_t i = net->ci[kmin], j = net->cj[kmin];
-            if (reserve((void **)&st->rem, &st->remcap, st->nrem + 1, sizeof *st->rem))
-                return sterr(st, ODHS_E_NOMEM, "out of memory");
-            st->rem[st->nrem].i = i;
-            st->rem[st->nrem].j = j;
-            st->nrem++;
-            odhs__net_remove_at(net, kmin);
-            if (record_change(st, i, j, -1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
+            if ((s = open_contact(st, kmin, NULL))) return s;
             continue;
         }
-        if (pj) {
-            /* positive self-stress: jammed. Polish the contacts to round-off,
-             * recompute f0 on the final geometry and scale it to unit
-             * pressure; nothing can move under this driving. */
-            if ((s = odhs__jam_polish(st->sys, net, st->sol, net->f)))
-                return sterr(st, s, "polishing the jammed packing: %s", odhs_strerror(s));
-            if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
-                return sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "jammed packing: %s",
-                             net->errmsg);
-            double fr = 0.0, vol;
-            for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
-            odhs_system_volume(st->sys, &vol);
-            double scale = vol * st->dim / fr;
-            for (size_t c = 0; c < net->nc; ++c) net->f[c] *= scale;
-            memset(st->U, 0, st->nd * sizeof *st->U);
-            st->jammed = 1;
-            return ODHS_OK;
-        }
+        if (pj) return jam_finish(st);
         compute_velocities(st);
-        if (st->nrem == 0) break;
-        double vs = velocity_scale(st), vmin = 0.0;
-        size_t rmin = SIZE_MAX;
-        for (size_t q = 0; q < st->nrem; ++q) {
-            double v = pair_velocity(st, st->rem[q].i, st->rem[q].j);
-            if (v < vmin) {
-                vmin = v;
-                rmin = q;
-            }
-        }
-        if (rmin == SIZE_MAX || vmin >= -EPS_V * vs) break;
-        size_t i = st->rem[rmin].i, j = st->rem[rmin].j;
-        st->rem[rmin] = st->rem[st->nrem - 1];
-        st->nrem--;
-        size_t c = odhs__net_add(net, i, j, ODHS_CONTACT_TEMPORARY);
-        if (c == SIZE_MAX || record_change(st, i, j, +1)) return sterr(st, ODHS_E_NOMEM, "out of memory");
-        contact_geometry(st, c);
+        int added = 0;
+        if ((s = close_pair(st, &added)) || !added) return s;
     }
-    return ODHS_OK;
 }
 
 /* ---- neighbour list ----------------------------------------------------- */
@@ -1035,6 +1171,21 @@ int odhs_stepper_get_settings(const odhs_stepper *st, int *integrator, double *d
     if (dt) *dt = st->dt;
     if (tol) *tol = st->tol;
     if (correction_interval) *correction_interval = st->corr_every;
+    return ODHS_OK;
+}
+
+int odhs_stepper_rewire_stats(const odhs_stepper *st, uint64_t *count)
+{
+    if (!st || !count) return ODHS_E_NULL;
+    *count = st->nrewire_monotone;
+    return ODHS_OK;
+}
+
+int odhs__stepper_set_rewire_mode(odhs_stepper *st, int mode)
+{
+    if (!st) return ODHS_E_NULL;
+    if (mode != 0 && mode != 1) return sterr(st, ODHS_E_INVALID, "rewire mode %d is not 0 or 1", mode);
+    st->rewire_mode = mode;
     return ODHS_OK;
 }
 

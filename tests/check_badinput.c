@@ -1795,6 +1795,10 @@ static int huge_rate_case(void)
       uint64_t r; double h; return odhs_stepper_adaptive_stats(NULL, &r, &h);)                                 \
     X(st_adaptive_all_null, odhs_stepper_adaptive_stats, ODHS_OK, NOALT, H_NONE, 0,                            \
       return odhs_stepper_adaptive_stats(w->run, NULL, NULL);)                                                 \
+    X(st_rewire_stats_null, odhs_stepper_rewire_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                          \
+      uint64_t c; return odhs_stepper_rewire_stats(NULL, &c);)                                                 \
+    X(st_rewire_stats_out_null, odhs_stepper_rewire_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                      \
+      return odhs_stepper_rewire_stats(w->run, NULL);)                                                         \
     X(st_counts_null, odhs_stepper_counts, ODHS_E_NULL, NOALT, H_NONE, 0,                                      \
       uint64_t a; return odhs_stepper_counts(NULL, &a, &a, &a);)                                               \
     X(st_counts_all_null, odhs_stepper_counts, ODHS_OK, NOALT, H_NONE, 0,                                      \

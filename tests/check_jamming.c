@@ -46,6 +46,7 @@
 
 #include "odhs.h"
 #include "testutil.h"
+#include "internal.h"
 
 /* certificate thresholds (the task's definition of "certified") */
 #define CERT_FORCE_BALANCE 1e-12
@@ -1005,6 +1006,259 @@ END_TEST
 
 
 /* ========================================================================== */
+/* Anti-cycling rewiring                                                      */
+/* ========================================================================== */
+/*
+ * The paper's rewiring rule can cycle close to jamming (0.2.1: jam_packing
+ * --n 1024 --seed 16 ended with ODHS_E_REWIRE, 63 pairs toggled over 8188
+ * iterations at phi = 0.84085). The stepper then continues with the
+ * Lawson-Hanson active-set method for the same complementarity problem. The
+ * checkpoint tests/data/rewire_cycle_2d_n1024.ckpt is that run (compression at
+ * rate 1, library defaults, cholmod-pcg) just before the step that cycled.
+ */
+static const char *test_data(const char *name, char *buf, size_t len)
+{
+    const char *dir = getenv("ODHS_TEST_DATA");
+    snprintf(buf, len, "%s/%s", dir ? dir : "tests/data", name);
+    return buf;
+}
+
+/* The complementarity conditions at the end of a step, recomputed from the
+ * public state with the exhaustive minimum image: every contact force >= 0
+ * (relative to the largest), every contact rigid, and no pair at contact
+ * outside the network approaching; the affine flow is compression at the
+ * stepper's kappa (-kappa r per unit length) plus simple shear at gdot. */
+static void lcp_check(odhs_system *sys, odhs_stepper *st, double gdot, double *worst_f, double *worst_rigid,
+                      double *worst_approach, size_t *n_outside)
+{
+    int d = odhs_system_dim(sys);
+    size_t n = odhs_system_count(sys), nd = n * (size_t)d;
+    const odhs_network *net = odhs_stepper_network(st);
+    size_t m = odhs_network_count(net);
+    double *x = xcalloc(nd, sizeof *x), *rad = xcalloc(n, sizeof *rad), *U = xcalloc(nd, sizeof *U),
+           *f = xcalloc(m, sizeof *f), L[3] = {0, 0, 0}, gamma, kappa;
+    CHECK_OK(odhs_system_get_positions(sys, x));
+    CHECK_OK(odhs_system_get_radii(sys, rad));
+    CHECK_OK(odhs_system_get_box(sys, L));
+    CHECK_OK(odhs_system_get_strain(sys, &gamma));
+    CHECK_OK(odhs_stepper_nonaffine_velocities(st, U));
+    CHECK_OK(odhs_stepper_kappa(st, &kappa));
+    CHECK_OK(odhs_network_get_forces(net, f));
+    double fbig = 0.0, umax = 0.0;
+    for (size_t c = 0; c < m; ++c) fbig = fmax(fbig, fabs(f[c]));
+    for (size_t k = 0; k < nd; ++k) umax = fmax(umax, fabs(U[k]));
+    double vs = umax + (fabs(gdot) + fabs(kappa)) * 2.0 * 0.75;
+    *worst_f = 0.0;
+    for (size_t c = 0; c < m; ++c) *worst_f = fmin(*worst_f, f[c] / fbig);
+    tu_pairlist pl;
+    tu_brute_pairs(d, n, x, rad, L, gamma, 1e-9, &pl);
+    ck_assert(!pl.alloc_failed);
+    *worst_rigid = *worst_approach = 0.0;
+    *n_outside = 0;
+    for (size_t q = 0; q < pl.n; ++q) {
+        const tu_pair *p = &pl.p[q];
+        double r = sqrt(tu_norm2(d, p->rij)), v = 0.0;
+        for (int k = 0; k < d; ++k) v += (U[p->j * d + k] - U[p->i * d + k]) * p->rij[k] / r;
+        v += gdot * p->rij[0] * p->rij[1] / r - kappa * r;
+        size_t idx;
+        CHECK_OK(odhs_network_find(net, p->i, p->j, &idx));
+        if (idx != SIZE_MAX) {
+            *worst_rigid = fmax(*worst_rigid, fabs(v) / vs);
+        } else if (p->gap < 1e-11) {
+            (*n_outside)++;
+            *worst_approach = fmin(*worst_approach, v / vs);
+        }
+    }
+    /* every contact must have been in the brute-force list */
+    ck_assert_msg(m <= pl.n, "%zu contacts but %zu pairs within 1e-9", m, pl.n);
+    tu_pairlist_free(&pl);
+    free(x);
+    free(rad);
+    free(U);
+    free(f);
+}
+
+START_TEST(test_anticycling_cycle)
+{
+    odhs_solver *sol;
+    if (odhs_solver_create_by_name("cholmod-pcg", &sol) != ODHS_OK) {
+        fprintf(stderr, "[jamming] anticycling: this build has no cholmod-pcg; the N = 1024 cycle is not run\n");
+        return;
+    }
+    char path[512], err[256];
+    odhs_system *sys;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    int rc = odhs_checkpoint_read(test_data("rewire_cycle_2d_n1024.ckpt", path, sizeof path), sol, &sys, &drv, &st,
+                                  err, sizeof err);
+    ck_assert_msg(rc == ODHS_OK, "reading %s: %s", path, err);
+    uint64_t m0 = 99, m1 = 0;
+    CHECK_OK(odhs_stepper_rewire_stats(st, &m0));
+    ck_assert_msg(m0 == 0, "a new stepper reports %llu anti-cycling rewirings", (unsigned long long)m0);
+    rc = odhs_stepper_step(st, NULL);
+    ck_assert_msg(rc == ODHS_OK, "step: %d (%s): %s", rc, odhs_strerror(rc), odhs_stepper_errmsg(st));
+    CHECK_OK(odhs_stepper_rewire_stats(st, &m1));
+    ck_assert_msg(m1 == 1, "%llu anti-cycling rewirings (the paper's rule cycles here: expected 1)",
+                  (unsigned long long)m1);
+    double wf, wr, wa;
+    size_t nout;
+    lcp_check(sys, st, 0.0, &wf, &wr, &wa, &nout);
+    fprintf(stderr,
+            "[jamming] anticycling N = 1024: %zu contacts, %zu pairs at contact outside; most negative force %.2e, "
+            "rigidity %.2e, most approaching outside pair %.2e\n",
+            odhs_network_count(odhs_stepper_network(st)), nout, wf, wr, wa);
+    ck_assert_msg(wf >= -1e-12, "negative force %.3g", wf);
+    ck_assert_msg(wr <= 1e-9, "a contact not rigid: %.3g", wr);
+    ck_assert_msg(wa >= -1e-10, "a pair at contact outside the network approaches: %.3g", wa);
+    /* and the run goes on to a certified packing */
+    rc = odhs_stepper_run_until_packing_fraction(st, 0.999);
+    ck_assert_msg(rc == ODHS_JAMMED, "run: %d (%s): %s", rc, odhs_strerror(rc), odhs_stepper_errmsg(st));
+    odhs_jam_certificate c;
+    c.size = sizeof c;
+    CHECK_OK(odhs_stepper_certificate(st, &c));
+    char cmsg[512];
+    cert_print(cmsg, sizeof cmsg, &c);
+    int ok = cert_passes(&c, 2);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+    odhs_solver_destroy(sol);
+    ck_assert_msg(ok, "certificate fails: %s", cmsg);
+}
+END_TEST
+
+/* The anti-cycling method alone (internal test switch) against the paper's
+ * rule: before every step of a run with the paper's rule its state is saved
+ * and read back into a second stepper that rewires with the anti-cycling
+ * method only; both take the step from the same state and solve the same
+ * complementarity problem, so the step must end with the same status, the
+ * same contacts and the same velocities (to round-off times the condition
+ * of N, which grows towards jamming), and the complementarity conditions
+ * must hold. Checkpoint continuation is bit-identical for the direct
+ * solver used here. */
+static const struct {
+    int dim;
+    size_t n;
+    uint64_t seed;
+    const char *protocol;
+} agree_cases[] = {
+    {2, 64, 1, "compress"}, {2, 64, 1, "shear+compress"}, {2, 64, 1, "pressure"}, {3, 48, 1, "compress"},
+};
+
+START_TEST(test_anticycling_agrees)
+{
+    jrun a;
+    int dim = agree_cases[_i].dim;
+    size_t n = agree_cases[_i].n, nd = n * (size_t)dim;
+    const char *protocol = agree_cases[_i].protocol;
+    odhs_solver *probe = NULL;
+    const char *solver = odhs_solver_create_by_name("cholmod", &probe) == ODHS_OK ? "cholmod" : "dense";
+    odhs_solver_destroy(probe);
+    jrun_start(&a, dim, n, agree_cases[_i].seed, protocol, solver);
+    ck_assert_int_eq(odhs__stepper_set_rewire_mode(a.st, 2), ODHS_E_INVALID);
+    double gdot = 0.0, p = 1.0, gnext = 0.05;
+    if (!strcmp(protocol, "compress")) {
+        CHECK_OK(odhs_driver_set_compression_rate(a.drv, 1.0));
+    } else if (!strcmp(protocol, "shear+compress")) {
+        gdot = 1.0;
+        CHECK_OK(odhs_driver_set_shear_rate(a.drv, 1.0));
+        CHECK_OK(odhs_driver_set_compression_rate(a.drv, 0.2));
+    } else {
+        gdot = 1.0;
+        CHECK_OK(odhs_driver_set_shear_rate(a.drv, 1.0));
+        CHECK_OK(odhs_driver_set_pressure(a.drv, p));
+    }
+    char path[] = "/tmp/odhs_anticycling_XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_msg(fd >= 0, "mkstemp");
+    close(fd);
+    double *Ua = xcalloc(nd, sizeof *Ua), *Ub = xcalloc(nd, sizeof *Ub);
+    double worst_u = 0.0, worst_f = 0.0, worst_r = 0.0, worst_a = 0.0;
+    long steps = 0, diff_net = -1, diff_rc = -1, openings = 0;
+    int ra = odhs_stepper_reset(a.st), rb = ODHS_OK;
+    uint64_t mono = 0;
+    while (ra == ODHS_OK && steps < 20000) {
+        CHECK_OK(odhs_checkpoint_write(a.st, path));
+        odhs_solver *solb;
+        odhs_system *sysb;
+        odhs_driver *drvb;
+        odhs_stepper *stb;
+        char err[256];
+        CHECK_OK(odhs_solver_create_by_name(solver, &solb));
+        int rr = odhs_checkpoint_read(path, solb, &sysb, &drvb, &stb, err, sizeof err);
+        ck_assert_msg(rr == ODHS_OK, "checkpoint: %s", err);
+        CHECK_OK(odhs__stepper_set_rewire_mode(stb, 1));
+        uint64_t o0 = 0, o1 = 0;
+        CHECK_OK(odhs_stepper_counts(a.st, NULL, NULL, &o0));
+        ra = odhs_stepper_step(a.st, NULL);
+        rb = odhs_stepper_step(stb, NULL);
+        CHECK_OK(odhs_stepper_counts(a.st, NULL, NULL, &o1));
+        openings += (long)(o1 - o0);
+        steps++;
+        CHECK_OK(odhs_stepper_rewire_stats(stb, &mono));
+        if (ra != rb && diff_rc < 0) diff_rc = steps;
+        if ((ra == ODHS_OK || ra == ODHS_JAMMED) && ra == rb) {
+            const odhs_network *na = odhs_stepper_network(a.st), *nb = odhs_stepper_network(stb);
+            size_t m = odhs_network_count(na);
+            int same = m == odhs_network_count(nb);
+            for (size_t c = 0; c < m && same; ++c) {
+                size_t i, j, idx;
+                CHECK_OK(odhs_network_get_contact(na, c, &i, &j, NULL));
+                CHECK_OK(odhs_network_find(nb, i, j, &idx));
+                same = idx != SIZE_MAX;
+            }
+            if (!same && diff_net < 0) diff_net = steps;
+            CHECK_OK(odhs_stepper_nonaffine_velocities(a.st, Ua));
+            CHECK_OK(odhs_stepper_nonaffine_velocities(stb, Ub));
+            double umax = 1e-300, du = 0.0;
+            for (size_t k = 0; k < nd; ++k) {
+                umax = fmax(umax, fabs(Ua[k]));
+                du = fmax(du, fabs(Ua[k] - Ub[k]));
+            }
+            worst_u = fmax(worst_u, du / umax);
+            if (ra == ODHS_OK) {
+                double wf, wr, wa;
+                size_t nout;
+                lcp_check(sysb, stb, gdot, &wf, &wr, &wa, &nout);
+                worst_f = fmin(worst_f, wf);
+                worst_r = fmax(worst_r, wr);
+                worst_a = fmin(worst_a, wa);
+            }
+        }
+        odhs_stepper_destroy(stb);
+        odhs_driver_destroy(drvb);
+        odhs_system_destroy(sysb);
+        odhs_solver_destroy(solb);
+        if (ra == ODHS_OK && !strcmp(protocol, "pressure")) {
+            double g;
+            CHECK_OK(odhs_stepper_strain(a.st, &g));
+            if (g >= gnext) {
+                p *= 2.0;
+                gnext += 0.05;
+                CHECK_OK(odhs_driver_set_pressure(a.drv, p));
+            }
+        }
+    }
+    unlink(path);
+    fprintf(stderr,
+            "[jamming] anticycling vs paper's rule, %dD N = %zu %s (%s): %ld steps, %ld openings, end %d / %d; "
+            "velocities differ by %.2e, first different network at step %ld, status at %ld; LCP: force %.2e, "
+            "rigidity %.2e, approach %.2e\n",
+            dim, n, protocol, solver, steps, openings, ra, rb, worst_u, diff_net, diff_rc, worst_f, worst_r, worst_a);
+    free(Ua);
+    free(Ub);
+    jrun_free(&a);
+    ck_assert_msg(ra == ODHS_JAMMED && rb == ODHS_JAMMED, "ends %d / %d", ra, rb);
+    ck_assert_msg(diff_rc < 0, "the statuses differ at step %ld", diff_rc);
+    ck_assert_msg(diff_net < 0, "the networks differ at step %ld", diff_net);
+    ck_assert_msg(openings > 0, "no contact opened: the rewiring was not exercised");
+    ck_assert_msg(worst_u < 1e-8, "velocities differ by %.3g", worst_u);
+    ck_assert_msg(worst_f >= -1e-12 && worst_r <= 1e-9 && worst_a >= -1e-10, "LCP: %.3g %.3g %.3g", worst_f,
+                  worst_r, worst_a);
+}
+END_TEST
+
+/* ========================================================================== */
 /* Fixed pressure through isostatic networks                                  */
 /* ========================================================================== */
 /*
@@ -1735,6 +1989,12 @@ Suite *make_jamming_suite(void)
     tc = tcase_create("pressure");
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, test_pressure_isostatic_flow);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("anticycling");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, test_anticycling_cycle);
+    tcase_add_loop_test(tc, test_anticycling_agrees, 0, (int)(sizeof agree_cases / sizeof agree_cases[0]));
     suite_add_tcase(s, tc);
 
     tc = tcase_create("large");

@@ -19,7 +19,9 @@
  * after NET, each at most once, CMP (rest lengths of bonds, rigid-body
  * labels), PROP (self-propulsion: settings, whether its clock runs, the
  * xoshiro256** state, current forces and switch times) and GRAV (gravity
- * field and weights). A checkpoint that needs none of them is still written
+ * field and weights), and since 0.2.2 DRVC (the driver was changed after
+ * the forces were solved: the restored stepper re-solves them at its next
+ * step, as the original would have). A checkpoint that needs none of them is still written
  * as version 1, so older releases read it; this library reads both.
  * Writes go to a temporary file in the same directory that is flushed, synced
  * and renamed over the target, so a crash mid-write leaves any previous

@@ -187,6 +187,16 @@ ODHS_API int odhs_stepper_get_settings(const odhs_stepper *st, int *integrator, 
 /** Adaptive-integrator counters: rejected steps and the current step (in tau
  *  units); either may be NULL. */
 ODHS_API int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejected, double *h);
+/** Rewirings that the anti-cycling method finished (since 0.2.2). The
+ *  paper's rule (drop the most negative force, re-connect the most
+ *  approaching removed pair; Sect. IV B) can cycle on degenerate networks
+ *  close to jamming; after 2 (contacts + 16) + 100 iterations of it the
+ *  stepper continues from the network reached with the active-set method of
+ *  Lawson and Hanson for the same complementarity problem, which cannot
+ *  cycle and stops on the same tests (forces >= 0, no removed pair
+ *  approaching). Counted since the stepper was created or read from a
+ *  checkpoint; *count may not be NULL. */
+ODHS_API int odhs_stepper_rewire_stats(const odhs_stepper *st, uint64_t *count);
 /** Counters: steps, collisions, openings (any output may be NULL). */
 ODHS_API int odhs_stepper_counts(const odhs_stepper *st, uint64_t *steps, uint64_t *collisions,
                                  uint64_t *openings);
