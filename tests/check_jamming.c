@@ -785,20 +785,32 @@ static void jrun_start(jrun *r, int dim, size_t n, uint64_t seed, const char *pr
     CHECK_OK(odhs_stepper_set_correction_interval(r->st, 1));
 }
 
-/* Drive as examples/jam_packing.c does; r->rc receives the final status. */
-static void jrun_drive(jrun *r)
+/* The driver of the protocol, as examples/jam_packing.c sets it up (fixed
+ * pressure starts at p = 1). */
+static void jrun_configure(jrun *r)
 {
     odhs_driver *drv = r->drv;
     if (!strcmp(r->protocol, "compress")) {
         CHECK_OK(odhs_driver_set_compression_rate(drv, 1.0));
-        r->rc = odhs_stepper_run_until_packing_fraction(r->st, 0.999);
     } else if (!strcmp(r->protocol, "shear+compress")) {
         CHECK_OK(odhs_driver_set_shear_rate(drv, 1.0));
         CHECK_OK(odhs_driver_set_compression_rate(drv, 0.2));
-        r->rc = odhs_stepper_run_until_packing_fraction(r->st, 0.999);
     } else if (!strcmp(r->protocol, "pressure")) {
         CHECK_OK(odhs_driver_set_shear_rate(drv, 1.0));
         CHECK_OK(odhs_driver_set_pressure(drv, 1.0));
+    } else {
+        ck_abort_msg("unknown protocol %s", r->protocol);
+    }
+}
+
+/* Drive as examples/jam_packing.c does; r->rc receives the final status. */
+static void jrun_drive(jrun *r)
+{
+    odhs_driver *drv = r->drv;
+    jrun_configure(r);
+    if (strcmp(r->protocol, "pressure")) {
+        r->rc = odhs_stepper_run_until_packing_fraction(r->st, 0.999);
+    } else {
         double p = 1.0;
         r->rc = ODHS_OK;
         for (double g = 0.05; g < 20.0 + 1e-9; g += 0.05) {
@@ -807,8 +819,6 @@ static void jrun_drive(jrun *r)
             p *= 2.0;
             CHECK_OK(odhs_driver_set_pressure(drv, p));
         }
-    } else {
-        ck_abort_msg("unknown protocol %s", r->protocol);
     }
 }
 
@@ -928,12 +938,15 @@ static int independent_check(const jrun *r, char *msg, size_t len)
     return ok;
 }
 
-static const struct {
+/* a start and a protocol */
+typedef struct {
     int dim;
     size_t n;
     uint64_t seed;
     const char *protocol;
-} pack_cases[] = {
+} jam_case;
+
+static const jam_case pack_cases[] = {
     /* Driven as jam_packing drives them (the library's default adaptive
      * integrator, correction every step, cholmod-pcg when available). The
      * shear+compress seeds 2-4 and the fixed-pressure cases were known
@@ -1136,12 +1149,7 @@ END_TEST
  * of N, which grows towards jamming), and the complementarity conditions
  * must hold. Checkpoint continuation is bit-identical for the direct
  * solver used here. */
-static const struct {
-    int dim;
-    size_t n;
-    uint64_t seed;
-    const char *protocol;
-} agree_cases[] = {
+static const jam_case agree_cases[] = {
     {2, 64, 1, "compress"}, {2, 64, 1, "shear+compress"}, {2, 64, 1, "pressure"}, {3, 48, 1, "compress"},
 };
 
@@ -1156,18 +1164,8 @@ START_TEST(test_anticycling_agrees)
     odhs_solver_destroy(probe);
     jrun_start(&a, dim, n, agree_cases[_i].seed, protocol, solver);
     ck_assert_int_eq(odhs__stepper_set_rewire_mode(a.st, 2), ODHS_E_INVALID);
-    double gdot = 0.0, p = 1.0, gnext = 0.05;
-    if (!strcmp(protocol, "compress")) {
-        CHECK_OK(odhs_driver_set_compression_rate(a.drv, 1.0));
-    } else if (!strcmp(protocol, "shear+compress")) {
-        gdot = 1.0;
-        CHECK_OK(odhs_driver_set_shear_rate(a.drv, 1.0));
-        CHECK_OK(odhs_driver_set_compression_rate(a.drv, 0.2));
-    } else {
-        gdot = 1.0;
-        CHECK_OK(odhs_driver_set_shear_rate(a.drv, 1.0));
-        CHECK_OK(odhs_driver_set_pressure(a.drv, p));
-    }
+    double gdot = strcmp(protocol, "compress") ? 1.0 : 0.0, p = 1.0, gnext = 0.05;
+    jrun_configure(&a);
     char path[] = "/tmp/odhs_anticycling_XXXXXX";
     int fd = mkstemp(path);
     ck_assert_msg(fd >= 0, "mkstemp");
