@@ -218,6 +218,7 @@ int main(int argc, char **argv)
         printf("worst contact gap      %.3e (relative to the contact distance)\n", c.gap_error);
         printf("worst overlap          %.3e\n", c.overlap);
         printf("smallest force         %.3e (relative to the mean force)\n", c.min_force);
+        printf("final pivots           %zu\n", c.n_pivots);
         int certified = c.jammed && c.isostatic && c.force_balance < 1e-12 && c.gap_error < 1e-13 &&
                         c.overlap <= 1e-14 && c.min_force > 0.0;
         printf("certified              %s\n", certified ? "yes" : "no");

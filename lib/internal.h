@@ -306,6 +306,10 @@ int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b,
 int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const double *b, double *x, double rtol);
 void odhs__solver_invalidate(odhs_solver *s);
 int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, const double *f0);
+/* the self-stress h of an isostatic network plus a pair (i, j) outside it,
+ * h = 1 on the pair, <h|r> = 0 (lib/jamming.c) */
+int odhs__jam_pair_stress(const odhs_network *net, odhs_solver *sol, const double *f0, size_t i, size_t j,
+                          const double *nrm, double dist, double *h);
 int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);
 /* fixed pressure: the kernel vector fs of S^T with <r|fs> = 0 (the volume as
  * one more column of S) on a constrained subset with d(Nbar - 1) + 2
@@ -427,6 +431,7 @@ struct odhs_stepper {
     size_t nrem, remcap;
     int rewire_mode;            /* 0: paper's rule, anti-cycling takeover; 1: anti-cycling only (tests) */
     uint64_t nrewire_monotone;  /* rewirings the anti-cycling method finished (not checkpointed) */
+    uint64_t njam_pivots;       /* pivots of jam_finish on the final packing (not checkpointed) */
     /* fixed pressure on a potentially jammed network: net->f = freg + alpha f0
      * with f0 then freg in fpj (2 nc); pj_bordered while net->f is of that form */
     double *fpj;

@@ -347,6 +347,65 @@ done:
     return st;
 }
 
+/* The pivot that takes a pair p = (i, j) outside an isostatic network C
+ * (self-stress f0, <f0|r> != 0) into it: the self-stress h of C + p with
+ * h_p = 1 and <h|r> = 0 (r: contact distances, the response of the gaps to
+ * an isotropic compression), h on C returned in h[0..nc-1]: h_C solves
+ * S_C'^T h = -s_p^T on C' = C without its contact of largest |f0| (full
+ * column rank), plus the multiple of f0 that sets <h|r> + r_p = 0. On C's
+ * constrained subset S_C^T has the range of every balanced force; a rattler
+ * in p needs d independent contacts of its own. ODHS_E_SINGULAR when the
+ * balance is not exact (h does not exist). nrm is the unit vector from i to
+ * j, dist |R_ij|. */
+int odhs__jam_pair_stress(const odhs_network *net, odhs_solver *sol, const double *f0, size_t i, size_t j,
+                          const double *nrm, double dist, double *h)
+{
+    int d = net->dim, st = ODHS_OK;
+    size_t nc = net->nc, nd = net->n * (size_t)d, k0 = 0;
+    if (nc < 2) return ODHS_E_STATE;
+    for (size_t c = 1; c < nc; ++c)
+        if (fabs(f0[c]) > fabs(f0[k0])) k0 = c;
+    odhs_network *sub = odhs__net_subnet(net, NULL, nc, k0);
+    double *g = odhs__calloc(nd, sizeof *g), *x = odhs__calloc(nc, sizeof *x), *F = odhs__calloc(nd, sizeof *F);
+    if (!sub || !g || !x || !F) {
+        st = ODHS_E_NOMEM;
+        goto done;
+    }
+    double gn = 0.0;
+    for (int a = 0; a < d; ++a) {
+        g[i * d + a] = nrm[a];
+        g[j * d + a] = -nrm[a];
+        gn += nrm[a] * nrm[a];
+    }
+    if ((st = odhs_solver_solve_ls(sol, sub, g, x))) goto done;
+    for (size_t c = 0, q = 0; c < nc; ++c) h[c] = c == k0 ? 0.0 : x[q++];
+    /* accept only an exact balance: S_C^T h = -s_p^T */
+    odhs__net_ST(net, h, F);
+    double res = 0.0, hmax = 1.0;
+    for (size_t q = 0; q < nd; ++q) res = fmax(res, fabs(F[q] - g[q]));
+    for (size_t c = 0; c < nc; ++c) hmax = fmax(hmax, fabs(h[c]));
+    if (!(res <= 1e-9 * hmax * sqrt(gn))) {
+        st = ODHS_E_SINGULAR;
+        goto done;
+    }
+    double hr = dist, fr = 0.0;
+    for (size_t c = 0; c < nc; ++c) {
+        hr += h[c] * net->dist[c];
+        fr += f0[c] * net->dist[c];
+    }
+    if (!(fabs(fr) > 0.0)) {
+        st = ODHS_E_SINGULAR;
+        goto done;
+    }
+    for (size_t c = 0; c < nc; ++c) h[c] -= hr / fr * f0[c];
+done:
+    odhs_network_destroy(sub);
+    odhs__free(g);
+    odhs__free(x);
+    odhs__free(F);
+    return st;
+}
+
 /* ---- certificate ---------------------------------------------------------- */
 typedef struct {
     const odhs_network *net;
@@ -393,6 +452,7 @@ int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert)
         return s;
     }
     c.jammed = st->jammed;
+    c.n_pivots = (size_t)st->njam_pivots;
     odhs_system_packing_fraction(sys, &c.phi);
     c.n_particles = n;
     c.n_backbone = nbar;

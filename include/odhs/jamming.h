@@ -10,6 +10,15 @@
  * pressure as the contact forces, and returns ODHS_JAMMED. Otherwise the most
  * negative contact is removed and the rewiring goes on, exactly as Sect. IV D
  * describes.
+ *
+ * Since 0.2.3 the polish is followed by a check of every pair outside the
+ * network: a pair of backbone particles that the polished geometry leaves
+ * overlapping (by more than 4e-15 of its contact distance; it touched the
+ * packing to within the precision of the integration) is taken into the
+ * network, and the contact that the dual simplex ratio test picks leaves it
+ * (the self-stress of the network plus the pair, kept positive, with the
+ * pressure fixed), then the packing is polished again; at most 64 such
+ * pivots. The certificate's n_pivots counts them. Scenes with walls skip it.
  */
 #ifndef ODHS_JAMMING_H
 #define ODHS_JAMMING_H
@@ -44,6 +53,10 @@ typedef struct odhs_jam_certificate {
     double gap_error;            /* max over contacts |gap| / (a_i + a_j)        */
     double overlap;              /* max over non-contact pairs of overlap/(a_i+a_j), 0 if none */
     double min_force;            /* smallest backbone force / mean f             */
+    /* since 0.2.3: pairs that the final pivots took into the network when
+     * this stepper found the packing (see above; 0 after a restore from a
+     * checkpoint, which does not store it) */
+    size_t n_pivots;
 } odhs_jam_certificate;
 
 /** Fill a certificate for the stepper's current state (jammed or not). */
