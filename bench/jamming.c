@@ -16,6 +16,10 @@
  *   ODHS_BENCH_CORRECTION  drift correction every K steps (default 1, as
  *                       examples/jam_packing: the contact gaps must be at
  *                       round-off when the packing jams)
+ *   ODHS_BENCH_TABLES   the tables to run, e.g. "3" (default "123"); a table
+ *                       left out is printed as skipped
+ *   ODHS_BENCH_SOFT_SIZES  the starts of table 3 as dim:N pairs separated by
+ *                       commas (default "2:256,2:1024,3:128", at most 8)
  *
  * Scene: 50:50 bidisperse discs/spheres, radii 0.5 and 0.7 (ratio 1.4), 3%
  * uniform polydispersity, random sequential placement at phi = 0.45 (2D) /
@@ -498,6 +502,10 @@ int main(int argc, char **argv)
     int dense = !strcmp(solver_name, "dense");
     machine(workers, budget);
     printf("# solver choice: %s\n", why);
+    const char *tabs = getenv("ODHS_BENCH_TABLES");
+    if (!tabs || !*tabs) tabs = "123";
+    int do1 = strchr(tabs, '1') != NULL, do2 = strchr(tabs, '2') != NULL, do3 = strchr(tabs, '3') != NULL;
+    printf("# tables: %s%s%s (ODHS_BENCH_TABLES)\n", do1 ? "1 " : "", do2 ? "2 " : "", do3 ? "3" : "");
 
     /* ---- pilot: one small packing per dimension, to size the plan ---------- */
     result pilot[2];
@@ -559,47 +567,53 @@ int main(int argc, char **argv)
     }
     double limit2 = fmax(120.0, 5.0 * estimate(t2, 128, n2, dense));
     double limit3 = fmax(120.0, 5.0 * estimate(t3, 64, n3, dense));
-    fprintf(stderr, "phi_J statistics: 2D N = %zu, %d seeds\n", n2, N_SEEDS);
-    run_pool(st2, N_SEEDS, workers, now() + share, limit2, 0);
-    fprintf(stderr, "phi_J statistics: 3D N = %zu, %d seeds\n", n3, N_SEEDS);
-    run_pool(st3, N_SEEDS, workers, now() + share, limit3, 0);
-    summary s2 = summarize(st2, N_SEEDS), s3 = summarize(st3, N_SEEDS);
+    if (!do1) {
+        for (int k = 0; k < N_SEEDS; ++k) st2[k].wall = st3[k].wall = -1.0; /* not run */
+        printf("\n## Table 1: skipped (ODHS_BENCH_TABLES)\n");
+    } else {
+        fprintf(stderr, "phi_J statistics: 2D N = %zu, %d seeds\n", n2, N_SEEDS);
+        run_pool(st2, N_SEEDS, workers, now() + share, limit2, 0);
+        fprintf(stderr, "phi_J statistics: 3D N = %zu, %d seeds\n", n3, N_SEEDS);
+        run_pool(st3, N_SEEDS, workers, now() + share, limit3, 0);
+        summary s2 = summarize(st2, N_SEEDS), s3 = summarize(st3, N_SEEDS);
 
-    printf("\n## Table 1: phi_J by compression (statistics over the runs that ended jammed)\n");
-    printf("%-3s %6s %5s %6s %9s %9s %10s %9s %9s %13s %10s %9s\n", "d", "N", "runs", "jammed", "certified",
-           "phi_mean", "phi_sd", "phi_min", "phi_max", "rattler_frac", "z_backbone", "s/packing");
-    const summary *ss[2] = {&s2, &s3};
-    size_t nn[2] = {n2, n3};
-    for (int d = 0; d < 2; ++d) {
-        const summary *s = ss[d];
-        printf("%-3d %6zu %5zu %6zu %9zu %9.5f %10.2e %9.5f %9.5f %13.4f %10.4f %9.1f\n", d + 2, nn[d], s->runs,
-               s->jammed, s->cert, s->phi_mean, s->phi_sd, s->phi_min, s->phi_max, s->rat_mean, s->z_mean,
-               s->sec_mean);
-        csv_row("phiJ", d + 2, nn[d], s, have_cholmod ? "" : "reduced size: no CHOLMOD backend");
-    }
-    printf("worst certificate numbers over the jammed runs (2D | 3D): force balance %.1e | %.1e, gap %.1e | %.1e,\n"
-           "  overlap %.1e | %.1e, smallest force %.1e | %.1e\n",
-           s2.fb, s3.fb, s2.gap, s3.gap, s2.ov, s3.ov, s2.minf, s3.minf);
-    for (int d = 0; d < 2; ++d) {
-        const result *r = d ? st3 : st2;
-        int first = 1;
-        for (int k = 0; k < N_SEEDS; ++k) {
-            if (r[k].wall < 0 || (r[k].done && r[k].certified)) continue;
-            if (first) printf("not certified (%dD):", d + 2);
-            first = 0;
-            if (r[k].wall < 0) continue;
-            if (!r[k].done) printf(" seed %u killed;", r[k].seed);
-            else if (r[k].rc != ODHS_JAMMED) printf(" seed %u rc %d (%s);", r[k].seed, r[k].rc, odhs_strerror(r[k].rc));
-            else
-                printf(" seed %u overlap %.1e min_force %.1e;", r[k].seed, r[k].cert.overlap, r[k].cert.min_force);
+        printf("\n## Table 1: phi_J by compression (statistics over the runs that ended jammed)\n");
+        printf("%-3s %6s %5s %6s %9s %9s %10s %9s %9s %13s %10s %9s\n", "d", "N", "runs", "jammed", "certified",
+               "phi_mean", "phi_sd", "phi_min", "phi_max", "rattler_frac", "z_backbone", "s/packing");
+        const summary *ss[2] = {&s2, &s3};
+        size_t nn[2] = {n2, n3};
+        for (int d = 0; d < 2; ++d) {
+            const summary *s = ss[d];
+            printf("%-3d %6zu %5zu %6zu %9zu %9.5f %10.2e %9.5f %9.5f %13.4f %10.4f %9.1f\n", d + 2, nn[d], s->runs,
+                   s->jammed, s->cert, s->phi_mean, s->phi_sd, s->phi_min, s->phi_max, s->rat_mean, s->z_mean,
+                   s->sec_mean);
+            csv_row("phiJ", d + 2, nn[d], s, have_cholmod ? "" : "reduced size: no CHOLMOD backend");
         }
-        size_t notrun = 0;
-        for (int k = 0; k < N_SEEDS; ++k) notrun += r[k].wall < 0;
-        if (!first) printf("\n");
-        if (notrun) printf("(%dD: %zu seeds not run: budget)\n", d + 2, notrun);
+        printf("worst certificate numbers over the jammed runs (2D | 3D): force balance %.1e | %.1e, gap %.1e | %.1e,\n"
+               "  overlap %.1e | %.1e, smallest force %.1e | %.1e\n",
+               s2.fb, s3.fb, s2.gap, s3.gap, s2.ov, s3.ov, s2.minf, s3.minf);
+        for (int d = 0; d < 2; ++d) {
+            const result *r = d ? st3 : st2;
+            int first = 1;
+            for (int k = 0; k < N_SEEDS; ++k) {
+                if (r[k].wall < 0 || (r[k].done && r[k].certified)) continue;
+                if (first) printf("not certified (%dD):", d + 2);
+                first = 0;
+                if (r[k].wall < 0) continue;
+                if (!r[k].done) printf(" seed %u killed;", r[k].seed);
+                else if (r[k].rc != ODHS_JAMMED)
+                    printf(" seed %u rc %d (%s);", r[k].seed, r[k].rc, odhs_strerror(r[k].rc));
+                else
+                    printf(" seed %u overlap %.1e min_force %.1e;", r[k].seed, r[k].cert.overlap, r[k].cert.min_force);
+            }
+            size_t notrun = 0;
+            for (int k = 0; k < N_SEEDS; ++k) notrun += r[k].wall < 0;
+            if (!first) printf("\n");
+            if (notrun) printf("(%dD: %zu seeds not run: budget)\n", d + 2, notrun);
+        }
+        csv_runs("phiJ", st2, N_SEEDS);
+        csv_runs("phiJ", st3, N_SEEDS);
     }
-    csv_runs("phiJ", st2, N_SEEDS);
-    csv_runs("phiJ", st3, N_SEEDS);
 
     /* ---- table 2: time to a certified packing ------------------------------------ */
     struct {
@@ -609,12 +623,20 @@ int main(int argc, char **argv)
     enum { NT = sizeof sizes / sizeof sizes[0] };
     result tr[NT];
     memset(tr, 0, sizeof tr);
-    printf("\n## Table 2: time to a certified packing (seed 1, one packing per row, run alone)\n");
-    printf("%-3s %6s %9s %10s %10s %8s %9s %9s %9s %9s %9s %9s %10s\n", "d", "N", "seconds", "cpu_s", "steps",
-           "jammed", "certified", "phi_J", "f_bal", "gap", "overlap", "min_f", "f0_LvsS");
     for (int k = 0; k < NT; ++k) {
         tr[k].dim = sizes[k].dim;
         tr[k].n = sizes[k].n;
+        tr[k].wall = -1.0; /* not run (yet) */
+    }
+    if (!do2) {
+        printf("\n## Table 2: skipped (ODHS_BENCH_TABLES)\n");
+    } else {
+        printf("\n## Table 2: time to a certified packing (seed 1, one packing per row, run alone)\n");
+        printf("%-3s %6s %9s %10s %10s %8s %9s %9s %9s %9s %9s %9s %10s\n", "d", "N", "seconds", "cpu_s", "steps",
+               "jammed", "certified", "phi_J", "f_bal", "gap", "overlap", "min_f", "f0_LvsS");
+    }
+    for (int k = 0; k < NT && do2; ++k) {
+        tr[k].wall = 0.0;
         tr[k].seed = 1;
         double est = sizes[k].dim == 2 ? estimate(t2, 128, sizes[k].n, dense) : estimate(t3, 64, sizes[k].n, dense);
         double left = budget - (now() - t_start);
@@ -652,18 +674,37 @@ int main(int argc, char **argv)
         summary e = summarize(r, 1);
         csv_row("timing", r->dim, r->n, &e, note);
     }
-    csv_runs("timing", tr, NT);
+    if (do2) csv_runs("timing", tr, NT);
 
     /* ---- table 3: the soft-sphere route on the same starts ------------------------ */
     struct {
         int dim;
         size_t n;
-    } soft_sizes[] = {{2, 256}, {2, 1024}, {3, 128}};
-    enum { NS = sizeof soft_sizes / sizeof soft_sizes[0] };
-    result sr[NS], er[NS];
+    } soft_sizes[8] = {{2, 256}, {2, 1024}, {3, 128}};
+    int NS = do3 ? 3 : 0;
+    const char *ss_env = getenv("ODHS_BENCH_SOFT_SIZES");
+    if (do3 && ss_env && *ss_env) {
+        NS = 0;
+        for (const char *q = ss_env; *q && NS < 8;) {
+            int dd = 0;
+            unsigned long nn = 0;
+            int used = 0;
+            if (sscanf(q, "%d:%lu%n", &dd, &nn, &used) != 2 || (dd != 2 && dd != 3) || nn < 2) {
+                fprintf(stderr, "jamming: bad ODHS_BENCH_SOFT_SIZES entry at \"%s\" (want dim:N,...)\n", q);
+                return 2;
+            }
+            soft_sizes[NS].dim = dd;
+            soft_sizes[NS].n = (size_t)nn;
+            NS++;
+            q += used;
+            if (*q == ',') q++;
+        }
+    }
+    result sr[8], er[8];
     memset(sr, 0, sizeof sr);
     memset(er, 0, sizeof er);
-    int have_er[NS] = {0};
+    int have_er[8] = {0};
+    if (!do3) printf("\n## Table 3: skipped (ODHS_BENCH_TABLES)\n");
     for (int k = 0; k < NS; ++k) {
         sr[k].dim = er[k].dim = soft_sizes[k].dim;
         sr[k].n = er[k].n = soft_sizes[k].n;
@@ -681,38 +722,40 @@ int main(int argc, char **argv)
                     break;
                 }
     }
-    fprintf(stderr, "soft-sphere route: %d starts\n", NS);
-    run_pool(sr, NS, workers, INFINITY, soft_limit, 0);
-    for (int k = 0; k < NS; ++k)
-        if (!have_er[k]) run_pool(&er[k], 1, 1, INFINITY, soft_limit, 0);
-    printf("\n## Table 3: soft-sphere route (harmonic, FIRE to max|F| < %.0e, jammed when U/N > %.0e,\n"
-           "##   compression steps from %.0e halved to %.0e relative) against the event-driven packing, same start\n",
-           SOFT_FTOL, SOFT_EJAM, SOFT_DPHI0, SOFT_DPHI_END);
-    printf("%-3s %6s %-13s %9s %9s %14s %14s %10s %10s %10s %8s %12s\n", "d", "N", "route", "seconds", "cpu_s",
-           "phi_J", "phi_J upper", "overlap", "gap", "resid_F", "z_bb", "work");
-    for (int k = 0; k < NS; ++k) {
-        const result *e = &er[k], *q = &sr[k];
-        if (e->done)
-            printf("%-3d %6zu %-13s %9.1f %9.1f %14.10f %14s %10.1e %10.1e %10.1e %8.4f %9llu st\n", e->dim, e->n,
-                   "event-driven", e->wall, e->cpu, e->cert.phi, "(exact)", e->cert.overlap, e->cert.gap_error,
-                   e->cert.force_balance, e->cert.z_backbone, (unsigned long long)e->steps);
-        else
-            printf("%-3d %6zu %-13s killed after %.0f s\n", e->dim, e->n, "event-driven", e->wall);
-        if (q->done && !q->rc)
-            printf("%-3d %6zu %-13s %9.1f %9.1f %14.10f %14.10f %10.1e %10s %10.1e %8.4f %6llu/%llu min/it\n",
-                   q->dim, q->n, "soft-sphere", q->wall, q->cpu, q->s_phi_lo, q->s_phi_hi, q->s_overlap, "-",
-                   q->s_fres, q->s_z, (unsigned long long)q->s_mins, (unsigned long long)q->s_iters);
-        else if (q->done)
-            printf("%-3d %6zu %-13s failed: %d (%s)\n", q->dim, q->n, "soft-sphere", q->rc, odhs_strerror(q->rc));
-        else
-            printf("%-3d %6zu %-13s killed after %.0f s\n", q->dim, q->n, "soft-sphere", q->wall);
-        if (e->done && q->done && !q->rc)
-            printf("    time soft/event-driven %.2f; phi_J difference (soft lower bound - event-driven) %+.2e\n",
-                   q->wall / e->wall, q->s_phi_lo - e->cert.phi);
-        if (csv && q->done)
-            fprintf(csv, "softsphere,%d,%zu,1,,,%.12f,%.12f,,,,%.5f,%.2f,%.2f,%llu,%.3e,,%.3e,,,%s\n", q->dim, q->n,
-                    q->s_phi_lo, q->s_phi_hi, q->s_z, q->wall, q->cpu, (unsigned long long)q->s_iters, q->s_fres,
-                    q->s_overlap, q->rc ? odhs_strerror(q->rc) : "");
+    if (NS) {
+        fprintf(stderr, "soft-sphere route: %d starts\n", NS);
+        run_pool(sr, NS, workers, INFINITY, soft_limit, 0);
+        for (int k = 0; k < NS; ++k)
+            if (!have_er[k]) run_pool(&er[k], 1, 1, INFINITY, soft_limit, 0);
+        printf("\n## Table 3: soft-sphere route (harmonic, FIRE to max|F| < %.0e, jammed when U/N > %.0e,\n"
+               "##   compression steps from %.0e halved to %.0e relative) against the event-driven packing, same start\n",
+               SOFT_FTOL, SOFT_EJAM, SOFT_DPHI0, SOFT_DPHI_END);
+        printf("%-3s %6s %-13s %9s %9s %14s %14s %10s %10s %10s %8s %12s\n", "d", "N", "route", "seconds", "cpu_s",
+               "phi_J", "phi_J upper", "overlap", "gap", "resid_F", "z_bb", "work");
+        for (int k = 0; k < NS; ++k) {
+            const result *e = &er[k], *q = &sr[k];
+            if (e->done)
+                printf("%-3d %6zu %-13s %9.1f %9.1f %14.10f %14s %10.1e %10.1e %10.1e %8.4f %9llu st\n", e->dim, e->n,
+                       "event-driven", e->wall, e->cpu, e->cert.phi, "(exact)", e->cert.overlap, e->cert.gap_error,
+                       e->cert.force_balance, e->cert.z_backbone, (unsigned long long)e->steps);
+            else
+                printf("%-3d %6zu %-13s killed after %.0f s\n", e->dim, e->n, "event-driven", e->wall);
+            if (q->done && !q->rc)
+                printf("%-3d %6zu %-13s %9.1f %9.1f %14.10f %14.10f %10.1e %10s %10.1e %8.4f %6llu/%llu min/it\n",
+                       q->dim, q->n, "soft-sphere", q->wall, q->cpu, q->s_phi_lo, q->s_phi_hi, q->s_overlap, "-",
+                       q->s_fres, q->s_z, (unsigned long long)q->s_mins, (unsigned long long)q->s_iters);
+            else if (q->done)
+                printf("%-3d %6zu %-13s failed: %d (%s)\n", q->dim, q->n, "soft-sphere", q->rc, odhs_strerror(q->rc));
+            else
+                printf("%-3d %6zu %-13s killed after %.0f s\n", q->dim, q->n, "soft-sphere", q->wall);
+            if (e->done && q->done && !q->rc)
+                printf("    time soft/event-driven %.2f; phi_J difference (soft lower bound - event-driven) %+.2e\n",
+                       q->wall / e->wall, q->s_phi_lo - e->cert.phi);
+            if (csv && q->done)
+                fprintf(csv, "softsphere,%d,%zu,1,,,%.12f,%.12f,,,,%.5f,%.2f,%.2f,%llu,%.3e,,%.3e,,,%s\n", q->dim, q->n,
+                        q->s_phi_lo, q->s_phi_hi, q->s_z, q->wall, q->cpu, (unsigned long long)q->s_iters, q->s_fres,
+                        q->s_overlap, q->rc ? odhs_strerror(q->rc) : "");
+        }
     }
     if (csv) fclose(csv);
     printf("\n# total %.0f s\n", now() - t_start);
