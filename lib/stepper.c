@@ -652,6 +652,41 @@ done:
     return s;
 }
 
+/* Sect. IV D on the final geometry: a jammed packing needs f0 > 0 on the
+ * backbone after the polish too. A polish that starts from large contact gaps
+ * (a coarse integration without drift correction) moves the backbone enough
+ * to change the signs; then the packing is not jammed, and the step is not
+ * taken (ODHS_POTENTIALLY_JAMMED, rolled back by the caller). */
+static int jam_check_f0(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    size_t nbar = 0, ncon = 0;
+    unsigned char *in = odhs__malloc_array(st->n, 1);
+    if (!in) return sterr(st, ODHS_E_NOMEM, "out of memory");
+    int s = odhs_network_constrained(net, &nbar, &ncon, in, NULL);
+    if (s) {
+        odhs__free(in);
+        return sterr(st, s, "%s", net->errmsg);
+    }
+    double big = 0.0, low = 0.0, fsum = 0.0;
+    size_t m = 0;
+    for (size_t c = 0; c < net->nc; ++c) {
+        if (!in[net->ci[c]] || (net->cj[c] < st->n && !in[net->cj[c]])) continue;
+        big = fmax(big, fabs(net->f[c]));
+        fsum += net->f[c];
+        m++;
+        if (odhs__can_open(net->kind[c])) low = fmin(low, net->f[c]);
+    }
+    odhs__free(in);
+    if (low < -EPS_F * big)
+        return sterr(st, ODHS_POTENTIALLY_JAMMED,
+                     "potentially jammed at t = %.17g: after the polish the self-stress has a negative component "
+                     "(%.3g of the mean force), so the packing is not jammed; the step was not taken (a drift "
+                     "correction before it gives the polish a closer start)",
+                     st->time, m && fsum > 0.0 ? low / (fsum / (double)m) : low);
+    return ODHS_OK;
+}
+
 /* The end of a rewiring on a jammed network (positive self-stress): polish
  * the contacts to round-off, take in any backbone pair that the polish left
  * overlapping (jam_pivot) and polish again, recompute f0 on the final
@@ -671,6 +706,7 @@ static int jam_finish(odhs_stepper *st)
         if (piv == JAM_PIVOTS || net->nwalls || (s = jam_pivot(st, &pivoted)) || !pivoted) break;
     }
     if (s || (s = jam_rattlers(st))) return s;
+    if ((s = jam_check_f0(st))) return s;
     double fr = 0.0, vol;
     for (size_t c = 0; c < net->nc; ++c) fr += net->f[c] * net->dist[c];
     odhs_system_volume(st->sys, &vol);

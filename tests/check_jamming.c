@@ -1071,6 +1071,64 @@ START_TEST(test_paper_scheme_certified)
 }
 END_TEST
 
+/*
+ * With the paper's scheme some runs reach the jamming network with contact
+ * gaps of 1e-2 to 1e-3, and the polish changes the signs of f0: 2D N = 48
+ * seed 2 ends with a component of -1.99 of the mean, 3D seed 4 with -0.25.
+ * Version 0.2.2 returned ODHS_JAMMED for them anyway (the certificate
+ * failed). Since 0.2.3 they are not jammed (Sect. IV D on the final
+ * geometry): the step returns ODHS_POTENTIALLY_JAMMED with a message and is
+ * not taken, the state is bit for bit the one before it, and the
+ * certificate says jammed = 0.
+ */
+static const jam_case unjammed_cases[] = {
+    {2, 48, 2, "compress"},
+    {3, 48, 4, "compress"},
+};
+
+START_TEST(test_paper_scheme_negative_f0)
+{
+    const jam_case *jc = &unjammed_cases[_i];
+    jrun r;
+    jrun_start(&r, jc->dim, jc->n, jc->seed, jc->protocol, "default");
+    CHECK_OK(odhs_stepper_set_integrator(r.st, ODHS_INTEGRATOR_EULER));
+    CHECK_OK(odhs_stepper_set_dt(r.st, 1e-3));
+    CHECK_OK(odhs_stepper_set_correction_interval(r.st, 10));
+    jrun_configure(&r);
+    size_t nd = r.n * (size_t)r.dim;
+    double *x0 = xcalloc(nd, sizeof *x0), *x1 = xcalloc(nd, sizeof *x1), L0[3], L1[3], t0 = 0.0, t1 = 0.0;
+    size_t nc0 = 0, steps = 0;
+    int rc = ODHS_OK;
+    while (rc == ODHS_OK && steps < 200000) {
+        CHECK_OK(odhs_system_get_positions(r.sys, x0));
+        CHECK_OK(odhs_system_get_box(r.sys, L0));
+        CHECK_OK(odhs_stepper_time(r.st, &t0));
+        nc0 = odhs_network_count(odhs_stepper_network(r.st));
+        odhs_event ev;
+        rc = odhs_stepper_step(r.st, &ev);
+        steps++;
+    }
+    CHECK_OK(odhs_system_get_positions(r.sys, x1));
+    CHECK_OK(odhs_system_get_box(r.sys, L1));
+    CHECK_OK(odhs_stepper_time(r.st, &t1));
+    size_t nc1 = odhs_network_count(odhs_stepper_network(r.st));
+    int same = t0 == t1 && nc0 == nc1 && !memcmp(x0, x1, nd * sizeof *x0) && !memcmp(L0, L1, (size_t)r.dim * sizeof *L0);
+    char msg[640];
+    snprintf(msg, sizeof msg, "%dD seed %llu: rc %d after %zu steps: %s", r.dim, (unsigned long long)jc->seed, rc,
+             steps, odhs_stepper_errmsg(r.st));
+    int neg = strstr(odhs_stepper_errmsg(r.st), "negative component") != NULL;
+    odhs_jam_certificate c;
+    c.size = sizeof c;
+    CHECK_OK(odhs_stepper_certificate(r.st, &c));
+    free(x0);
+    free(x1);
+    jrun_free(&r);
+    ck_assert_msg(rc == ODHS_POTENTIALLY_JAMMED && neg, "%s", msg);
+    ck_assert_msg(same, "%s: the failed step changed the state", msg);
+    ck_assert_msg(c.jammed == 0, "%s: certificate says jammed", msg);
+}
+END_TEST
+
 typedef struct {
     const unsigned char *in;
     const odhs_network *net;
@@ -2169,6 +2227,7 @@ Suite *make_jamming_suite(void)
     tcase_add_loop_test(tc, test_pivot_certified, 0, (int)(sizeof pivot_cases / sizeof pivot_cases[0]));
     tcase_add_loop_test(tc, test_paper_scheme_certified, 0, (int)(sizeof paper_cases / sizeof paper_cases[0]));
     tcase_add_loop_test(tc, test_pair_stress_identities, 0, 2);
+    tcase_add_loop_test(tc, test_paper_scheme_negative_f0, 0, (int)(sizeof unjammed_cases / sizeof unjammed_cases[0]));
     suite_add_tcase(s, tc);
 
     tc = tcase_create("anticycling");

@@ -54,7 +54,9 @@ enum {
     ODHS_STOPPED = 1,          /* a user callback asked to stop the run      */
     ODHS_POTENTIALLY_JAMMED = 2, /* constrained subset isostatic and its
                                   self-stress f0 could not be used (fixed
-                                  pressure, or f0 not computable); the run
+                                  pressure, or f0 not computable, or since
+                                  0.2.3 not positive on the polished
+                                  geometry: see jamming.h); the run
                                   stopped                                    */
     ODHS_JAMMED = 3,           /* jammed: the constrained subset is isostatic
                                   and its self-stress f0 is positive; the

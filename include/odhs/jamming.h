@@ -19,6 +19,17 @@
  * (the self-stress of the network plus the pair, kept positive, with the
  * pressure fixed), then the packing is polished again; at most 64 such
  * pivots. The certificate's n_pivots counts them. Scenes with walls skip it.
+ * A rattler left overlapping (it has too few contacts to be pivoted in) is
+ * moved out of the overlap, and its force-free contacts open (not with bonds
+ * or walls).
+ *
+ * Since 0.2.3 f0 must also be positive on the final (polished) geometry. A
+ * polish that starts from large contact gaps (a coarse integration with a
+ * sparse drift correction, such as the paper's Euler scheme with correction
+ * every 10 steps) can change its signs; then the packing is not jammed, the
+ * step returns ODHS_POTENTIALLY_JAMMED with a message, and it is not taken
+ * (the state stays as before the step). Version 0.2.2 returned ODHS_JAMMED
+ * there, and only the certificate showed it.
  */
 #ifndef ODHS_JAMMING_H
 #define ODHS_JAMMING_H
