@@ -456,6 +456,41 @@ static int jam_ov_cb(size_t i, size_t j, const double *rij, double gap, void *vc
     return 0;
 }
 
+/* backbone (constrained subset) flags of the network, n entries; *in is
+ * NULL after an error (the stepper's message is set) */
+static int jam_backbone(odhs_stepper *st, unsigned char **in)
+{
+    size_t nbar = 0, ncon = 0;
+    *in = odhs__malloc_array(st->n, 1);
+    if (!*in) return sterr(st, ODHS_E_NOMEM, "out of memory");
+    int s = odhs_network_constrained(st->net, &nbar, &ncon, *in, NULL);
+    if (s) {
+        odhs__free(*in);
+        *in = NULL;
+        return sterr(st, s, "%s", st->net->errmsg);
+    }
+    return ODHS_OK;
+}
+
+/* the most negative force on an openable backbone contact (0 if none) and
+ * the largest |f| and the mean f over the backbone contacts */
+static double jam_backbone_low(const odhs_stepper *st, const unsigned char *in, double *big, double *mean)
+{
+    const odhs_network *net = st->net;
+    double low = 0.0, sum = 0.0;
+    size_t m = 0;
+    *big = 0.0;
+    for (size_t c = 0; c < net->nc; ++c) {
+        if (!in[net->ci[c]] || (net->cj[c] < st->n && !in[net->cj[c]])) continue;
+        *big = fmax(*big, fabs(net->f[c]));
+        sum += net->f[c];
+        m++;
+        if (odhs__can_open(net->kind[c])) low = fmin(low, net->f[c]);
+    }
+    *mean = m ? sum / (double)m : 0.0;
+    return low;
+}
+
 /* One pivot of the jammed packing, a dual simplex step of the linear
  * programme "largest isotropic compression with every gap >= 0" around the
  * current geometry, whose vertex is the isostatic network C with self-stress
@@ -471,26 +506,20 @@ static int jam_ov_cb(size_t i, size_t j, const double *rij, double gap, void *vc
 static int jam_pivot(odhs_stepper *st, int *pivoted)
 {
     odhs_network *net = st->net;
-    size_t nc = net->nc, nbar = 0, ncon = 0;
-    int s = ODHS_OK;
+    size_t nc = net->nc;
     *pivoted = 0;
-    unsigned char *in = odhs__malloc_array(st->n, 1);
-    double *h = odhs__calloc(nc + 1, sizeof *h);
-    if (!in || !h) {
+    unsigned char *in = NULL;
+    double *h = NULL;
+    int s = jam_backbone(st, &in);
+    if (s) goto done;
+    if (!(h = odhs__calloc(nc + 1, sizeof *h))) {
         s = sterr(st, ODHS_E_NOMEM, "out of memory");
         goto done;
     }
-    if ((s = odhs_network_constrained(net, &nbar, &ncon, in, NULL))) {
-        s = sterr(st, s, "%s", net->errmsg);
-        goto done;
-    }
     /* only from a dual feasible vertex: f0 >= 0 on the backbone (a negative
-     * f0 after the polish is left to the certificate) */
-    double f0max = 0.0;
-    for (size_t c = 0; c < nc; ++c) f0max = fmax(f0max, fabs(net->f[c]));
-    for (size_t c = 0; c < nc; ++c)
-        if (odhs__can_open(net->kind[c]) && in[net->ci[c]] && in[net->cj[c]] && !(net->f[c] >= -EPS_F * f0max))
-            goto done;
+     * f0 after the polish is jam_check_f0's) */
+    double f0max, f0mean;
+    if (jam_backbone_low(st, in, &f0max, &f0mean) < -EPS_F * f0max) goto done;
     jam_ov_ctx oc = {net, in, st->sys->r, st->dim, {JAM_OVERLAP, JAM_OVERLAP}, {SIZE_MAX, SIZE_MAX},
                      {SIZE_MAX, SIZE_MAX}, {{0, 0, 0}, {0, 0, 0}}};
     s = odhs__pairs(st->dim, st->n, st->sys->x, st->sys->r, st->sys->rmax, st->sys->L, st->sys->gamma, 0.0, jam_ov_cb,
@@ -601,20 +630,17 @@ static int jam_rattlers(odhs_stepper *st)
 {
     odhs_network *net = st->net;
     odhs_system *sys = st->sys;
-    int d = st->dim, s = ODHS_OK;
-    size_t nbar = 0, ncon = 0;
+    int d = st->dim;
     if (net->nperm || net->nwalls) return ODHS_OK;
-    unsigned char *in = odhs__malloc_array(st->n, 1), *moved = odhs__calloc(st->n, 1);
+    unsigned char *in = NULL, *moved = NULL;
+    int s = jam_backbone(st, &in);
     jam_push_ctx pc = {net, in, sys->r, d, 0, 0, NULL, 0};
-    if (!in || !moved) {
+    if (s) goto done;
+    if (!(moved = odhs__calloc(st->n, 1))) {
         s = sterr(st, ODHS_E_NOMEM, "out of memory");
         goto done;
     }
-    if ((s = odhs_network_constrained(net, &nbar, &ncon, in, NULL))) {
-        s = sterr(st, s, "%s", net->errmsg);
-        goto done;
-    }
-    if (nbar == st->n) goto done;
+    if (!memchr(in, 0, st->n)) goto done; /* no rattlers */
     for (int sweep = 0; sweep < JAM_RATTLER_SWEEPS; ++sweep) {
         pc.m = 0;
         s = odhs__pairs(d, st->n, sys->x, sys->r, sys->rmax, sys->L, sys->gamma, 0.0, jam_push_cb, &pc);
@@ -659,39 +685,25 @@ done:
  * taken (ODHS_POTENTIALLY_JAMMED, rolled back by the caller). */
 static int jam_check_f0(odhs_stepper *st)
 {
-    odhs_network *net = st->net;
-    size_t nbar = 0, ncon = 0;
-    unsigned char *in = odhs__malloc_array(st->n, 1);
-    if (!in) return sterr(st, ODHS_E_NOMEM, "out of memory");
-    int s = odhs_network_constrained(net, &nbar, &ncon, in, NULL);
-    if (s) {
-        odhs__free(in);
-        return sterr(st, s, "%s", net->errmsg);
-    }
-    double big = 0.0, low = 0.0, fsum = 0.0;
-    size_t m = 0;
-    for (size_t c = 0; c < net->nc; ++c) {
-        if (!in[net->ci[c]] || (net->cj[c] < st->n && !in[net->cj[c]])) continue;
-        big = fmax(big, fabs(net->f[c]));
-        fsum += net->f[c];
-        m++;
-        if (odhs__can_open(net->kind[c])) low = fmin(low, net->f[c]);
-    }
+    unsigned char *in = NULL;
+    int s = jam_backbone(st, &in);
+    if (s) return s;
+    double big, mean, low = jam_backbone_low(st, in, &big, &mean);
     odhs__free(in);
     if (low < -EPS_F * big)
         return sterr(st, ODHS_POTENTIALLY_JAMMED,
                      "potentially jammed at t = %.17g: after the polish the self-stress has a negative component "
                      "(%.3g of the mean force), so the packing is not jammed; the step was not taken (a drift "
                      "correction before it gives the polish a closer start)",
-                     st->time, m && fsum > 0.0 ? low / (fsum / (double)m) : low);
+                     st->time, mean > 0.0 ? low / mean : low);
     return ODHS_OK;
 }
 
 /* The end of a rewiring on a jammed network (positive self-stress): polish
- * the contacts to round-off, take in any backbone pair that the polish left
- * overlapping (jam_pivot) and polish again, recompute f0 on the final
- * geometry and scale it to unit pressure; nothing can move under this
- * driving. */
+ * the contacts to round-off, take in any pair that the polish left
+ * overlapping (jam_pivot) and polish again, move overlapping rattlers out
+ * (jam_rattlers), check f0 on the final geometry (jam_check_f0) and scale it
+ * to unit pressure; nothing can move under this driving. */
 static int jam_finish(odhs_stepper *st)
 {
     odhs_network *net = st->net;
