@@ -12,9 +12,10 @@
  * describes.
  *
  * Since 0.2.3 the polish is followed by a check of every pair outside the
- * network: a pair of backbone particles that the polished geometry leaves
- * overlapping (by more than 4e-15 of its contact distance; it touched the
- * packing to within the precision of the integration) is taken into the
+ * network: a pair that the polished geometry leaves overlapping (by more
+ * than 4e-15 of its contact distance; it touched the packing to within the
+ * precision of the integration), of two backbone particles or of one and a
+ * rattler with d contacts of its own, is taken into the
  * network, and the contact that the dual simplex ratio test picks leaves it
  * (the self-stress of the network plus the pair, kept positive, with the
  * pressure fixed), then the packing is polished again; at most 64 such
