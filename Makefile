@@ -148,7 +148,7 @@ CHECK_LIBS   = $(eval CHECK_LIBS := $(shell $(PKG_CONFIG) --libs check))$(CHECK_
 # ---------------------------------------------------------------------------
 # Library sources and products (wildcards: new files are picked up).
 # ---------------------------------------------------------------------------
-LIB_SRCS := $(sort $(wildcard lib/*.c lib/solvers/*.c))
+LIB_SRCS := $(sort $(wildcard lib/*.c lib/*/*.c))
 LIB_OBJS := $(LIB_SRCS:%.c=$(OBJDIR)/%.o)
 
 STATIC_LIB     := $(OUT_LIBDIR)/libodhs.a

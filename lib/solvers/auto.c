@@ -53,7 +53,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "solvers/solvers.h"
 
 enum { B_CG, B_DENSE, B_CHOLMOD, B_CHOLMOD_PCG, B_SPQR, B_LSQ_SVD, B_LSQ_CG, B_COUNT };
 static const char *const bname[B_COUNT] = {"cg", "dense", "cholmod", "cholmod-pcg", "spqr", "lsq-svd", "lsq-cg"};

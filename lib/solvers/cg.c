@@ -2,7 +2,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "solvers/solvers.h"
 
 typedef struct {
     double tol;

@@ -98,7 +98,7 @@
 #pragma GCC diagnostic pop
 #endif
 
-#include "internal.h"
+#include "solvers/solvers.h"
 
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "solvers/solvers.h"
 
 typedef struct {
     double *A;      /* nc*nc column-major factor */

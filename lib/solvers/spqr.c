@@ -51,7 +51,7 @@
 #include <SuiteSparseQR_C.h>
 #pragma GCC diagnostic pop
 
-#include "internal.h"
+#include "solvers/solvers.h"
 
 typedef struct {
     cholmod_common cc;

@@ -3,7 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "solvers/solvers.h"
 
 static int solerr(const odhs_solver *s, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
 static int solerr(const odhs_solver *s, int status, const char *fmt, ...)

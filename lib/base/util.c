@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "base/base.h"
 
 const char *odhs_version_string(void) { return ODHS_VERSION_STRING; }
 int odhs_version_number(void) { return ODHS_VERSION_NUMBER; }
@@ -159,3 +159,15 @@ uint64_t odhs__rng_next(odhs_rng *r)
 }
 
 double odhs__rng_uniform(odhs_rng *r) { return (double)(odhs__rng_next(r) >> 11) * 0x1.0p-53; }
+
+int odhs__reserve(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (*cap >= need) return ODHS_OK;
+    size_t c = *cap ? *cap : 16;
+    while (c < need) c *= 2;
+    void *q = odhs__realloc(*p, c * elem);
+    if (!q) return ODHS_E_NOMEM;
+    *p = q;
+    *cap = c;
+    return ODHS_OK;
+}

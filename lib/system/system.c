@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "system/system.h"
 
 /* Overlaps smaller than this fraction of the pair's contact distance are
  * accepted as contacts (round-off in configurations written by the library). */

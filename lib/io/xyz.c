@@ -29,7 +29,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "internal.h"
+#include "system/system.h"
 
 #define ODHS_XYZ_OVERLAP_ACCEPT 1e-4 /* relative overlap accepted when reading */
 

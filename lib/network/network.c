@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "network/network.h"
 
 int odhs__neterr(const odhs_network *net, int status, const char *fmt, ...)
 {

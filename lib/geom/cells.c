@@ -9,7 +9,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "geom/geom.h"
 
 void odhs__wrap(int dim, const double *L, double gamma, double *x)
 {

@@ -2,7 +2,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "driver/driver.h"
 
 static int drverr(const odhs_driver *d, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
 static int drverr(const odhs_driver *d, int status, const char *fmt, ...)

@@ -13,7 +13,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "stepper/stepper.h"
 
 static int cerr(const odhs_stepper *st, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
 static int cerr(const odhs_stepper *st, int status, const char *fmt, ...)

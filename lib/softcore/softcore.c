@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "network/network.h"
 
 struct odhs_softcore {
     odhs_system *sys;

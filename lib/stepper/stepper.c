@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "stepper/stepper.h"
 
 #define EPS_F 1e-12 /* relative threshold for negative forces   */
 #define EPS_V 1e-12 /* relative threshold for approaching pairs */

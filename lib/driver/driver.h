@@ -1,0 +1,64 @@
+/*
+ * libodhs private header: the driver handle: affine flow, external forces, self-propulsion
+ * and gravity.
+ * Not installed.
+ */
+#ifndef ODHS_DRIVER_DRIVER_H
+#define ODHS_DRIVER_DRIVER_H
+
+#include "system/system.h"
+
+/* ---- driver ---------------------------------------------------------------- */
+struct odhs_driver {
+    double xi0;
+    double gdot;       /* shear rate */
+    double crate;      /* compression rate */
+    int pressure_on;
+    double p;
+    double kappa_max;
+    double *F;         /* fixed forces or NULL */
+    size_t Fn;
+    int Fdim;
+    odhs_force_fn fn;
+    void *fn_ctx;
+    double tau_user;   /* 0 = unset */
+    uint64_t version;  /* bumped by every setter: steppers re-solve on change */
+    char errmsg[ODHS_ERRMSG_LEN];
+    /* self-propulsion (Sect. V B); switches do not bump version: the stepper
+     * applies them at the end of the step that reaches the switch time */
+    int prop_on, prop_started;
+    size_t pn;
+    int pdim;
+    double pfmin, pfmax, ptmin, ptmax;
+    odhs_rng prng;
+    double *pF;        /* pn*pdim current propulsion forces */
+    double *pts;       /* pn switch times (before the start: persistence in units of tau_p) */
+    odhs_rng prng_b;   /* copy for the stepper's rollback */
+    int pstarted_b;
+    double *pF_b, *pts_b;
+    /* gravity */
+    int grav_on, gdim;
+    double g[3];
+    double *gw;        /* gwn weights, or NULL: (a_i/<a>)^d */
+    size_t gwn;
+};
+
+/* propulsion and gravity (lib/driver.c) */
+double odhs__prop_fp(const odhs_driver *d);               /* sqrt(<|F_p|^2>) */
+/* allocate the propulsion arrays for n particles in dim (frees old ones) */
+int odhs__prop_alloc(odhs_driver *d, size_t n, int dim);
+/* start the clock at time t (no-op when off or started) */
+void odhs__prop_start(odhs_driver *d, double t, double lambda);
+/* earliest switch time; INFINITY when off or not started */
+double odhs__prop_next(const odhs_driver *d);
+/* redraw every particle whose switch time is <= t, new switch at t + tau_p u */
+void odhs__prop_switch(odhs_driver *d, double t, double lambda);
+void odhs__prop_save(odhs_driver *d);
+void odhs__prop_restore(odhs_driver *d);
+/* settings consistent with a system of n particles in dim? ODHS_OK or ODHS_E_DIM */
+int odhs__driver_check_extra(const odhs_driver *d, size_t n, int dim);
+/* add propulsion and gravity to F (zeroed first when *has == 0; *has set when
+ * anything was added). ODHS_E_DIM when the settings do not fit sys. */
+int odhs__driver_extra_forces(const odhs_driver *d, const odhs_system *sys, double *F, int *has);
+
+#endif /* ODHS_DRIVER_DRIVER_H */

@@ -1,0 +1,51 @@
+/* libodhs - I/O: the contacts file of a network (pairs, image shifts, force, gap). */
+#include <stdio.h>
+#include <string.h>
+
+#include "network/network.h"
+
+int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const char *path)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!sys || !path) return odhs__neterr(net, ODHS_E_NULL, "NULL argument");
+    if (sys->n != net->n || sys->dim != net->dim)
+        return odhs__neterr(net, ODHS_E_DIM, "system and network differ in N or dimension");
+    if (!sys->has_x || !sys->has_r) return odhs__neterr(net, ODHS_E_STATE, "system radii and positions unset");
+    size_t len = strlen(path);
+    char *tmp = odhs__malloc(len + 32);
+    if (!tmp) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    snprintf(tmp, len + 32, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        int e = odhs__neterr(net, ODHS_E_IO, "cannot write %s", tmp);
+        odhs__free(tmp);
+        return e;
+    }
+    int d = net->dim, ok = 1;
+    ok &= fprintf(f, "# libodhs contacts N=%zu dim=%d Nc=%zu\n", net->n, d, net->nc) > 0;
+    ok &= fprintf(f, "# i j %s force gap\n", d == 2 ? "s0 s1" : "s0 s1 s2") > 0;
+    for (size_t c = 0; c < net->nc && ok; ++c) {
+        size_t i = net->ci[c], j = net->cj[c];
+        double v[3] = {0, 0, 0};
+        int img[3] = {0, 0, 0};
+        if (j < net->n) { /* walls (j = N + w) have no image shift */
+            for (int a = 0; a < d; ++a) v[a] = sys->x[j * d + a] - sys->x[i * d + a];
+            odhs__min_image(d, sys->L, sys->gamma, v, img);
+        }
+        if (d == 2)
+            ok &= fprintf(f, "%zu %zu %d %d %.17g %.17g\n", i, j, img[0], img[1], net->f[c], net->gap[c]) > 0;
+        else
+            ok &= fprintf(f, "%zu %zu %d %d %d %.17g %.17g\n", i, j, img[0], img[1], img[2], net->f[c],
+                          net->gap[c]) > 0;
+    }
+    ok &= fflush(f) == 0;
+    ok &= fclose(f) == 0;
+    if (!ok || rename(tmp, path) != 0) {
+        remove(tmp);
+        int e = odhs__neterr(net, ODHS_E_IO, "error writing %s", path);
+        odhs__free(tmp);
+        return e;
+    }
+    odhs__free(tmp);
+    return ODHS_OK;
+}

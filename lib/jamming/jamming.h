@@ -1,0 +1,23 @@
+/*
+ * libodhs private header: self-stress (null vectors), polishing and the pair self-stress
+ * of jammed packings (Sect. IV D).
+ * Not installed.
+ */
+#ifndef ODHS_JAMMING_JAMMING_H
+#define ODHS_JAMMING_JAMMING_H
+
+#include "solvers/solvers.h"
+
+int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, const double *f0);
+/* the self-stress h of an isostatic network plus a pair (i, j) outside it,
+ * h = 1 on the pair, <h|r> = 0 (lib/jamming.c) */
+int odhs__jam_pair_stress(const odhs_network *net, odhs_solver *sol, const double *f0, size_t i, size_t j,
+                          const double *nrm, double dist, double *h);
+int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);
+/* fixed pressure: the kernel vector fs of S^T with <r|fs> = 0 (the volume as
+ * one more column of S) on a constrained subset with d(Nbar - 1) + 2
+ * contacts, max |fs| = 1, sign undetermined; by the SVD of that matrix
+ * (lib/jamming.c) */
+int odhs__null_vector_volume(const odhs_network *net, double *fs);
+
+#endif /* ODHS_JAMMING_JAMMING_H */
