@@ -61,4 +61,28 @@ int odhs__driver_check_extra(const odhs_driver *d, size_t n, int dim);
  * anything was added). ODHS_E_DIM when the settings do not fit sys. */
 int odhs__driver_extra_forces(const odhs_driver *d, const odhs_system *sys, double *F, int *has);
 
+/* ---- the affine flow (lib/driver/flow.c) ----------------------------------
+ * What the stepper needs of the driver's flow. Times are the stepper's. */
+/* shear rate gammadot(t): side = +1 the rate from t on, side = -1 the rate
+ * up to t (the end of a step; the two differ only where the rate jumps) */
+double odhs__flow_shear_rate(const odhs_driver *d, double t, int side);
+/* velocity gradient G (row-major 3x3) at time t: gammadot(t) e_x e_y^T -
+ * c_eff I in dim dimensions (c_eff: the isotropic compression rate, which
+ * the stepper sets from the compression rate or the pressure control) */
+void odhs__flow_gradient(const odhs_driver *d, double t, int side, int dim, double c_eff, double *G);
+/* accumulated shear strain over [t0, t0 + dt] */
+double odhs__flow_strain_increment(const odhs_driver *d, double t0, double dt);
+/* time from t (accumulated strain `strain`) to the strain target; 0 when
+ * reached (to 1e-15 relative) or behind */
+double odhs__flow_time_to_strain(const odhs_driver *d, double t, double strain, double target);
+/* whether run-until-strain can be used with this driver (message into errbuf) */
+int odhs__flow_check_strain_target(const odhs_driver *d, char *errbuf);
+/* the earliest time at which the driving switches (a step ends exactly
+ * there and the forces are re-evaluated): an overdue propulsion switch, or
+ * else the first switch after t; INFINITY for none */
+double odhs__driver_next_switch(const odhs_driver *d, double t);
+/* the driver's settings consistent with a stepper of n particles in dim
+ * with nwalls walls? ODHS_OK, or a status with its message in errbuf */
+int odhs__driver_check(const odhs_driver *d, size_t n, int dim, size_t nwalls, char *errbuf);
+
 #endif /* ODHS_DRIVER_DRIVER_H */

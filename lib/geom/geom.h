@@ -107,4 +107,15 @@ static inline double odhs__wall_geom(const odhs_wall *w, int dim, const double *
 
 /* ---- contact network ----------------------------------------------------- */
 
+/* G d: the affine relative velocity of a separation d under the velocity
+ * gradient G (row-major 3x3) */
+static inline void odhs__apply_G(const double *G, int dim, const double *d, double *out)
+{
+    for (int a = 0; a < dim; ++a) {
+        double s = 0.0;
+        for (int b = 0; b < dim; ++b) s += G[3 * (a) + (b)] * d[b];
+        out[a] = s;
+    }
+}
+
 #endif /* ODHS_GEOM_GEOM_H */

@@ -37,6 +37,8 @@ struct odhs_stepper {
     double *Up;       /* adaptive: predictor velocities U* of the accepted step (nd) */
     double Gp[9], taup; /* ... its gradient and step length */
     int pred_ok;      /* Up, Gp, taup belong to the current step */
+    int flow_end;     /* the forces are evaluated at the end of a step (the
+                       * driver's flow up to st->time) */
     int corr_user;    /* the correction interval was set (not the integrator's default) */
     double *disps;    /* adaptive: displacement record at the start (nd) */
     double Ms[9];
@@ -99,5 +101,131 @@ struct odhs_stepper {
     size_t nev, evcap;
     char errmsg[ODHS_ERRMSG_LEN];
 };
+
+/* ==== shared by the stepper's files ======================================== */
+#define EPS_F 1e-12 /* relative threshold for negative forces   */
+#define EPS_V 1e-12 /* relative threshold for approaching pairs */
+
+/* record an error message on the stepper (logically mutable) */
+int odhs__sterr(const odhs_stepper *st, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
+
+/* the driver's shear rate at the stepper's time (its left limit while the
+ * adaptive scheme evaluates the end of a step) */
+static inline double odhs__st_shear_rate(const odhs_stepper *st)
+{
+    return odhs__flow_shear_rate(st->drv, st->time, st->flow_end ? -1 : +1);
+}
+
+/* minimum-image separation R_j - R_i (3 entries, unused ones 0) */
+static inline void odhs__st_min_sep(const odhs_stepper *st, size_t i, size_t j, double *d)
+{
+    const odhs_system *s = st->sys;
+    int dim = st->dim;
+    d[0] = d[1] = d[2] = 0.0;
+    for (int k = 0; k < dim; ++k) d[k] = s->x[j * dim + k] - s->x[i * dim + k];
+    odhs__min_image(dim, s->L, s->gamma, d, NULL);
+}
+
+/* ---- step types (integrators), in the manner of GSL's gsl_odeiv2_step_type:
+ * the step loop (step.c) plans a chord with `chord`, fits it to the
+ * neighbour list, predicts the first collision on it, moves, and lets the
+ * scheme repeat the step shorter at three points (the hooks may be NULL). */
+typedef struct {
+    double limit;      /* largest time the step may advance */
+    double tplan;      /* planned length of the chord */
+    double G[9];       /* the chord: velocity gradient ... */
+    const double *vel; /* ... and non-affine velocities (nd) */
+    double t;          /* length moved: to the first collision or tplan */
+    size_t ci, cj;     /* that collision (SIZE_MAX: none) */
+    double tsw, dsw;   /* next switch time of the driver, and the time left to it */
+    int at_switch;     /* the step ended at the switch time */
+    int relocated;     /* the step was repeated with a shorter chord */
+    int nhalve;        /* times the planned step was halved */
+} odhs__step_plan;
+
+typedef struct {
+    int id;                /* ODHS_INTEGRATOR_* */
+    const char *name;
+    unsigned corr_default; /* default drift-correction interval */
+    /* at the start of a step, before any motion (may be NULL) */
+    void (*begin)(odhs_stepper *st);
+    /* the chord over at most p->limit: p->G, p->vel, p->tplan */
+    int (*chord)(odhs_stepper *st, odhs__step_plan *p);
+    /* after the prediction: 1 = plan again (p->limit changed), 0 = move */
+    int (*early)(odhs_stepper *st, odhs__step_plan *p);
+    /* after the move, before a collision is added: *again = 1 after putting
+     * the state back to the start of the step (odhs__st_restart) with a new
+     * p->limit */
+    int (*at_collision)(odhs_stepper *st, odhs__step_plan *p, int *again);
+    /* likewise after the external forces at the end of a step without a
+     * collision (an opening inside the step) */
+    int (*at_opening)(odhs_stepper *st, odhs__step_plan *p, int *again);
+} odhs__step_type;
+
+extern const odhs__step_type odhs__step_euler; /* euler.c: the paper's scheme */
+extern const odhs__step_type odhs__step_heun;  /* heun.c: adaptive Heun */
+/* the step type of ODHS_INTEGRATOR_* id, NULL if none */
+const odhs__step_type *odhs__step_type_find(int id);
+
+/* ---- forces.c: forces and velocities on the current network ---------------- */
+int odhs__st_reserve_contacts(odhs_stepper *st, size_t nc);
+/* the affine velocity gradient with isotropic compression rate c_eff at the
+ * stepper's time, from the driver's flow */
+void odhs__st_set_gradient(odhs_stepper *st, double c_eff);
+/* external forces at the current time into st->F (st->has_F) */
+int odhs__st_external_forces(odhs_stepper *st);
+int odhs__st_solve(odhs_stepper *st, const double *b, double *x);
+/* (S V_aff)_c + w_c: the gap rate of contact c under the affine flow G
+ * (w_c: a wall's own velocity) */
+double odhs__st_affine_rate(const odhs_stepper *st, const double *G, size_t c);
+/* b = -S (V_aff + xi0 F) / xi0 without the pressure part of V_aff */
+void odhs__st_affine_rhs(odhs_stepper *st, double *b);
+/* contact forces into net->f (and kappa, G) */
+int odhs__st_compute_forces(odhs_stepper *st);
+void odhs__st_compute_velocities(odhs_stepper *st);
+double odhs__st_velocity_scale(const odhs_stepper *st);
+/* relative normal velocity of a pair (j >= n: wall j - n), contact or not */
+double odhs__st_pair_velocity(const odhs_stepper *st, size_t i, size_t j);
+void odhs__st_contact_geometry(odhs_stepper *st, size_t c);
+/* add contact (i, j) to the network and the step's changes; *c its index */
+int odhs__st_add_contact(odhs_stepper *st, size_t i, size_t j, size_t *c);
+
+/* ---- pressure.c: fixed pressure -------------------------------------------- */
+/* the forces (net->f), kappa and G at fixed pressure */
+int odhs__st_pressure_forces(odhs_stepper *st);
+/* the zero-pressure self-stress of a network with one contact more than
+ * isostatic, signed against the driving, into net->f */
+int odhs__st_pressure_open_direction(odhs_stepper *st);
+int odhs__st_solve_isostatic(odhs_stepper *st, const double *f0, double *rhs, double *x, double tol);
+int odhs__st_isostatic_f0(odhs_stepper *st);
+int odhs__st_correct_isostatic(odhs_stepper *st, double *Z);
+
+/* ---- rewire.c, endgame.c ---------------------------------------------------- */
+int odhs__st_rewire(odhs_stepper *st);
+int odhs__st_open_contact(odhs_stepper *st, size_t k, double *x);
+int odhs__st_jam_finish(odhs_stepper *st);
+
+/* ---- neighbours.c, predict.c, motion.c ------------------------------------ */
+int odhs__st_build_neighbours(odhs_stepper *st);
+double odhs__st_skin_used(const odhs_stepper *st);
+double odhs__st_skin_rate(const odhs_stepper *st, const double *G, const double *vel);
+double odhs__st_predict(const odhs_stepper *st, const double *G, const double *vel, double horizon, double vtol,
+                        int moving, int current, size_t *pi, size_t *pj);
+void odhs__st_advance(odhs_stepper *st, const double *G, const double *vel, double t);
+void odhs__st_advance_walls(odhs_stepper *st, double t);
+
+/* ---- save.c, correct.c, events.c, lifecycle.c ------------------------------ */
+int odhs__st_save(odhs_stepper *st);
+/* back to the positions, walls and box of the saved state */
+void odhs__st_restore_motion(odhs_stepper *st);
+/* the whole saved state back (a failed step) */
+void odhs__st_rollback(odhs_stepper *st);
+/* back to the start of the step before any contact changed, with the
+ * displacement record of the scheme's begin (a step repeated shorter) */
+int odhs__st_restart(odhs_stepper *st);
+int odhs__st_correct(odhs_stepper *st, int *added);
+int odhs__st_record_change(odhs_stepper *st, size_t i, size_t j, int delta);
+int odhs__st_emit_events(odhs_stepper *st, odhs_event *first, int *stop);
+int odhs__st_check_driver(odhs_stepper *st);
 
 #endif /* ODHS_STEPPER_STEPPER_H */

@@ -1,0 +1,270 @@
+/* libodhs - one step (Sect. IV A of the paper) and the run loops. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "stepper/stepper.h"
+
+/* ---- one step (Sect. IV A) ----------------------------------------------- */
+/* What a failed step puts back besides the state saved by odhs__st_save. */
+typedef struct {
+    uint64_t drv_version, nrejected;
+    double tau, h;
+    int psaved; /* self-propulsion state saved (odhs__prop_save) */
+} step_undo;
+
+static int undo(odhs_stepper *st, const step_undo *u, int s)
+{
+    if (u->psaved) odhs__prop_restore(st->drv);
+    odhs__st_rollback(st);
+    /* the forces are again those of the start of the step: solved for the
+     * driver as it was then (a changed driver is re-solved next time) */
+    st->drv_version = u->drv_version;
+    st->tau = u->tau;
+    st->h = u->h;
+    st->nrejected = u->nrejected;
+    st->jammed = 0;
+    st->nchg = 0;
+    return s;
+}
+
+/* The driver changed since the forces were solved (or propulsion switches
+ * are overdue, e.g. on a driver shared by steppers): re-solve. *done when the
+ * new driving opened or closed contacts: that is this step's event, at the
+ * current time and with no motion. */
+static int driver_update(odhs_stepper *st, step_undo *u, odhs_event *first, int *stop, int *done)
+{
+    int s;
+    *done = 0;
+    if (st->drv_version == st->drv->version && !(odhs__driver_next_switch(st->drv, st->time) <= st->time)) return ODHS_OK;
+    if ((s = odhs__st_check_driver(st))) return s;
+    if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) return odhs__sterr(st, s, "%s", st->drv->errmsg);
+    odhs__prop_save(st->drv);
+    u->psaved = 1;
+    odhs__prop_start(st->drv, st->time, st->lambda);
+    odhs__prop_switch(st->drv, st->time, st->lambda);
+    if ((s = odhs__st_external_forces(st)) || (s = odhs__st_rewire(st))) return s;
+    st->drv_version = st->drv->version;
+    if (!st->nchg) return ODHS_OK;
+    st->nsteps++;
+    *done = 1;
+    return odhs__st_emit_events(st, first, stop);
+}
+
+/* the chord must stay inside the neighbour list's skin: rebuild the list
+ * when it would not, and shorten the chord to 0.9 of the new skin */
+static int fit_neighbours(odhs_stepper *st, odhs__step_plan *p)
+{
+    double rate = odhs__st_skin_rate(st, p->G, p->vel);
+    if (!st->nb_stale && !(odhs__st_skin_used(st) + rate * p->tplan > st->skin)) return ODHS_OK;
+    st->nb_stale = 0;
+    int s = odhs__st_build_neighbours(st);
+    if (s) return s;
+    rate = odhs__st_skin_rate(st, p->G, p->vel);
+    if (rate * p->tplan > 0.9 * st->skin) p->tplan = 0.9 * st->skin / rate;
+    return ODHS_OK;
+}
+
+/* move by p->t along the chord; the clock follows */
+static int move(odhs_stepper *st, odhs__step_plan *p)
+{
+    odhs__st_advance(st, p->G, p->vel, p->t);
+    if (st->net->nwalls) odhs__st_advance_walls(st, p->t);
+    for (size_t k = 0; k < st->nd; ++k)
+        if (!isfinite(st->sys->x[k]))
+            return odhs__sterr(st, ODHS_E_NONFINITE, "non-finite positions after a step of %g (rates too large?)",
+                               p->t);
+    if (!isfinite(st->sys->L[0]) || !(st->sys->L[0] > 0.0) || !isfinite(st->sys->gamma))
+        return odhs__sterr(st, ODHS_E_NONFINITE, "the box became degenerate after a step of %g", p->t);
+    p->at_switch = p->ci == SIZE_MAX && p->t == p->dsw; /* the step reached the switch time */
+    const double t0 = st->time;
+    st->time = p->at_switch ? p->tsw : t0 + p->t;
+    st->strain += odhs__flow_strain_increment(st->drv, t0, p->t);
+    st->nsteps++;
+    return ODHS_OK;
+}
+
+/* a scheme's hook that may repeat the step: *again = 1 to plan it anew */
+static int repeat(odhs_stepper *st, int (*hook)(odhs_stepper *, odhs__step_plan *, int *), odhs__step_plan *p,
+                  int *again)
+{
+    *again = 0;
+    return hook ? hook(st, p, again) : ODHS_OK;
+}
+
+/* Sect. IV A (i)-(ii): the chord, the first collision on it, the motion to
+ * it, the new contact and the external forces at the step's end; the scheme
+ * may repeat the step shorter (a collision or an opening inside it) */
+static int advance_to_event(odhs_stepper *st, const odhs__step_type *type, odhs__step_plan *p)
+{
+    int s, again;
+    for (;;) {
+        if ((s = type->chord(st, p)) || (s = fit_neighbours(st, p))) return s;
+        p->t = odhs__st_predict(st, p->G, p->vel, p->tplan, EPS_V * odhs__st_velocity_scale(st), 1, 1, &p->ci,
+                                &p->cj);
+        if (type->early && type->early(st, p)) continue;
+        if ((s = move(st, p)) || (s = repeat(st, type->at_collision, p, &again))) return s;
+        if (again) continue;
+        size_t c;
+        if (p->ci != SIZE_MAX && (s = odhs__st_add_contact(st, p->ci, p->cj, &c))) return s;
+        odhs__net_geometry(st->net, st->sys);
+        if ((s = odhs__st_external_forces(st)) || (s = repeat(st, type->at_opening, p, &again))) return s;
+        if (!again) return ODHS_OK;
+    }
+}
+
+/* Sect. IV A (iii)-(iv) and IV C: new forces of the driver at a switch time,
+ * drift correction (before the rewiring: its solve is then that of the
+ * corrected geometry, and contacts the correction adds are rewired with the
+ * step's events), rewiring, events */
+static int end_step(odhs_stepper *st, const odhs__step_plan *p, step_undo *u, odhs_event *first, int *stop)
+{
+    int s;
+    if (p->at_switch) {
+        if (!u->psaved) odhs__prop_save(st->drv);
+        u->psaved = 1;
+        odhs__prop_switch(st->drv, st->time, st->lambda);
+        if ((s = odhs__st_external_forces(st))) return s;
+    }
+    if (st->corr_every && st->nsteps % st->corr_every == 0) {
+        int added = 0;
+        if ((s = odhs__st_correct(st, &added))) return s;
+    }
+    if ((s = odhs__st_rewire(st))) return s;
+    return odhs__st_emit_events(st, first, stop);
+}
+
+/* One step: limit is the largest time to advance (INFINITY for none); *stop
+ * is set by the event callback. A failed step leaves the state of its start. */
+static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
+{
+    int s, done = 0;
+    if (first) {
+        memset(first, 0, sizeof *first);
+        first->kind = ODHS_EVENT_NONE;
+    }
+    if (!st->ready && (s = odhs_stepper_reset(st))) return s;
+    if (st->jammed) return odhs__sterr(st, ODHS_JAMMED, "the packing is jammed: no further steps under this driving");
+    if ((s = odhs__st_save(st))) return s;
+    step_undo u = {st->drv_version, st->nrejected, st->tau, st->h, 0};
+    st->nchg = 0;
+    if ((s = driver_update(st, &u, first, stop, &done))) return undo(st, &u, s);
+    if (done) return ODHS_OK;
+    const odhs__step_type *type = odhs__step_type_find(st->integrator);
+    odhs__step_plan p = {0};
+    st->pred_ok = 0;
+    if (type->begin) type->begin(st);
+    /* a step ends exactly at the driver's next switch time */
+    p.tsw = odhs__driver_next_switch(st->drv, st->time);
+    p.dsw = p.tsw - st->time;
+    p.limit = p.dsw <= limit ? p.dsw : limit;
+    if ((s = advance_to_event(st, type, &p)) || (s = end_step(st, &p, &u, first, stop))) return undo(st, &u, s);
+    if (st->jammed)
+        return odhs__sterr(st, ODHS_JAMMED, "jammed at t = %.17g: isostatic constrained subset, positive self-stress",
+                           st->time);
+    return ODHS_OK;
+}
+
+
+int odhs_stepper_correct(odhs_stepper *st)
+{
+    if (!st) return ODHS_E_NULL;
+    int s, stop = 0, added = 0;
+    if (!st->ready && (s = odhs_stepper_reset(st))) return s;
+    if ((s = odhs__st_save(st))) return s;
+    const int jammed0 = st->jammed;
+    st->nchg = 0;
+    if ((s = odhs__st_correct(st, &added))) goto fail;
+    if ((s = odhs__st_rewire(st))) goto fail;
+    if ((s = odhs__st_emit_events(st, NULL, &stop))) goto fail;
+    if (st->jammed) return ODHS_JAMMED;
+    return stop ? ODHS_STOPPED : ODHS_OK;
+fail:
+    odhs__st_rollback(st);
+    st->jammed = jammed0;
+    st->nchg = 0;
+    return s;
+}
+
+int odhs_stepper_step(odhs_stepper *st, odhs_event *ev)
+{
+    if (!st) return ODHS_E_NULL;
+    int stop = 0;
+    int s = do_step(st, INFINITY, ev, &stop);
+    if (s) return s;
+    return stop ? ODHS_STOPPED : ODHS_OK;
+}
+
+/* generic run loop: remaining() gives the time left to the target (<= 0: done) */
+typedef double (*remaining_fn)(const odhs_stepper *st, const void *arg);
+
+static int run(odhs_stepper *st, remaining_fn rem, const void *arg, uint64_t max_events)
+{
+    uint64_t ev0 = st->ncoll + st->nopen;
+    for (;;) {
+        double left = rem ? rem(st, arg) : INFINITY;
+        if (!(left > 0.0)) return ODHS_OK;
+        if (max_events && st->ncoll + st->nopen - ev0 >= max_events) return ODHS_OK;
+        int stop = 0;
+        int s = do_step(st, left, NULL, &stop);
+        if (s) return s;
+        if (stop) return ODHS_STOPPED;
+    }
+}
+
+static double rem_time(const odhs_stepper *st, const void *arg)
+{
+    double t = *(const double *)arg;
+    double left = t - st->time;
+    return left > 1e-15 * fabs(t) ? left : 0.0;
+}
+
+int odhs_stepper_run_until_time(odhs_stepper *st, double t)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(t)) return odhs__sterr(st, ODHS_E_NONFINITE, "target time is not finite");
+    return run(st, rem_time, &t, 0);
+}
+
+static double rem_strain(const odhs_stepper *st, const void *arg)
+{
+    return odhs__flow_time_to_strain(st->drv, st->time, st->strain, *(const double *)arg);
+}
+
+int odhs_stepper_run_until_strain(odhs_stepper *st, double gamma)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(gamma)) return odhs__sterr(st, ODHS_E_NONFINITE, "target strain is not finite");
+    int s = odhs__flow_check_strain_target(st->drv, st->errmsg);
+    if (s) return s;
+    return run(st, rem_strain, &gamma, 0);
+}
+
+int odhs_stepper_run_events(odhs_stepper *st, uint64_t count)
+{
+    if (!st) return ODHS_E_NULL;
+    if (count == 0) return ODHS_OK;
+    return run(st, NULL, NULL, count);
+}
+
+static double rem_phi(const odhs_stepper *st, const void *arg)
+{
+    double target = *(const double *)arg, phi;
+    odhs_system_packing_fraction(st->sys, &phi);
+    if (phi >= target * (1.0 - 1e-15)) return 0.0;
+    double c = -st->G[3 * (1) + (1)]; /* current isotropic compression rate */
+    if (!(c > 0.0)) return INFINITY;
+    /* phi grows as (1 - c t)^(-d) over a straight step */
+    return (1.0 - pow(phi / target, 1.0 / st->dim)) / c;
+}
+
+int odhs_stepper_run_until_packing_fraction(odhs_stepper *st, double phi)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!isfinite(phi)) return odhs__sterr(st, ODHS_E_NONFINITE, "target packing fraction is not finite");
+    if (!(phi > 0.0) || phi >= 1.0) return odhs__sterr(st, ODHS_E_INVALID, "packing fraction must be in (0,1)");
+    if (st->drv->crate <= 0.0 && !st->drv->pressure_on)
+        return odhs__sterr(st, ODHS_E_STATE, "run_until_packing_fraction needs compression or pressure driving");
+    return run(st, rem_phi, &phi, 0);
+}
