@@ -13,6 +13,7 @@
 #include "odhs/driver.h"
 #include "odhs/stepper.h"
 #include "odhs/walls.h"
+#include "odhs/composite.h"
 #include "odhs/jamming.h"
 #include "odhs/checkpoint.h"
 #include "odhs/softcore.h"

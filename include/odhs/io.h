@@ -66,6 +66,19 @@ struct odhs_network; /* see network.h */
 ODHS_API int odhs_svg_write(const odhs_system *sys, const struct odhs_network *net,
                             const unsigned char *mark, const char *path);
 
+/**
+ * Write the contacts of a network to a text file: comment lines starting with
+ * '#' (N, dim, Nc and the column names), then one line per contact
+ * "i j s0 s1 [s2] force gap" with the lattice image shift s such that the
+ * contact vector is R_ij = x_j - x_i + s0 a + s1 b + s2 c (system.h), the
+ * force and the gap, numbers with 17 significant digits (a contact with wall w
+ * is "i N+w 0 0 [0] force gap"). Written atomically
+ * (temporary file, then rename). Errors: ODHS_E_NULL, ODHS_E_DIM (system and
+ * network differ), ODHS_E_IO. (Declared in odhs/jamming.h before 0.2.4, which still includes
+ * this header.)
+ */
+ODHS_API int odhs_contacts_write(const struct odhs_network *net, const odhs_system *sys, const char *path);
+
 #ifdef __cplusplus
 }
 #endif

@@ -35,6 +35,7 @@
 #ifndef ODHS_JAMMING_H
 #define ODHS_JAMMING_H
 
+#include "odhs/io.h"
 #include "odhs/stepper.h"
 
 #ifdef __cplusplus
@@ -74,17 +75,7 @@ typedef struct odhs_jam_certificate {
 /** Fill a certificate for the stepper's current state (jammed or not). */
 ODHS_API int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert);
 
-/**
- * Write the contacts of a network to a text file: comment lines starting with
- * '#' (N, dim, Nc and the column names), then one line per contact
- * "i j s0 s1 [s2] force gap" with the lattice image shift s such that the
- * contact vector is R_ij = x_j - x_i + s0 a + s1 b + s2 c (system.h), the
- * force and the gap, numbers with 17 significant digits (a contact with wall w
- * is "i N+w 0 0 [0] force gap"). Written atomically
- * (temporary file, then rename). Errors: ODHS_E_NULL, ODHS_E_DIM (system and
- * network differ), ODHS_E_IO.
- */
-ODHS_API int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const char *path);
+/* odhs_contacts_write (the contacts file) is declared in odhs/io.h. */
 
 #ifdef __cplusplus
 }

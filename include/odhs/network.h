@@ -146,8 +146,8 @@ struct odhs_solver; /* see solver.h */
  * contact), with the sign fixed so that sum f0 > 0 and scaled to mean 1 over
  * the subset's contacts. f0 has Nc entries. The network must be potentially
  * jammed (else ODHS_E_STATE). Method: with solver == NULL, or a subset of at
- * most 600 contacts, the eigenvector of the smallest eigenvalue of N on the
- * subset (LAPACK dsyevr); otherwise one contact k is fixed to f0_k = 1 and the
+ * most 600 contacts, the right singular vector of the smallest singular value
+ * of S^T on the subset (LAPACK dgesvd; since 0.2.1); otherwise one contact k is fixed to f0_k = 1 and the
  * rest solve S'^T y = -s_k^T in the least-squares sense with the solver on the
  * remaining contacts (other k are tried if that network is singular).
  * *residual (may be NULL) receives max_i |(S^T f0)_i| / mean f0.
