@@ -12,8 +12,10 @@
  * step uses the average velocity on a straight chord, so collisions are
  * still located exactly on the motion actually taken. Error estimate: the
  * difference between the Euler and Heun non-affine displacements,
- * tau/2 max_i |U*_i - U0_i|, relative to the mean diameter. On return *Ga, st->Ua
- * hold the chord's gradient and velocities and *tau the accepted step. */
+ * tau/2 max_i |U*_i - U0_i|, relative to the mean diameter, or that of the
+ * affine displacement of neighbours when the shear rate changes over the
+ * step. On return *Ga, st->Ua hold the chord's gradient and velocities and
+ * *tau the accepted step. */
 /* Smallest adaptive step, relative to dt: without a floor an accepted step
  * with an infinite error estimate (fac = 0) or repeated rejections from a
  * tiny h set h to 0 and the integrator stalls forever (found by fuzzing the
@@ -83,6 +85,11 @@ static int heun_probe(odhs_stepper *st, const double *G0, const double *M0, doub
         emax = fmax(emax, e2);
     }
     *err = 0.5 * tau * sqrt(emax) / st->lambda;
+    /* a shear rate that changes over the step (a time-dependent flow) moves
+     * neighbours, a distance lambda apart, off the chord by tau/2 |dgdot|
+     * lambda: relative to lambda, that counts too (0 for a constant rate) */
+    double dg = st->G[3 * 0 + 1] - G0[3 * 0 + 1];
+    if (!s && dg != 0.0) *err = fmax(*err, 0.5 * tau * fabs(dg));
     memcpy(Gs, st->G, 9 * sizeof *Gs);
     /* back to the start of the step */
     odhs__st_restore_motion(st);
