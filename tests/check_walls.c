@@ -380,6 +380,51 @@ START_TEST(test_walls_checkpoint)
 }
 END_TEST
 
+/* Contacts with walls made by collisions are of kind ODHS_CONTACT_WALL (0.2.3
+ * stored them as temporary, so a checkpoint taken after a particle met a
+ * wall was refused on reading), and a run with them continues bit for bit. */
+START_TEST(test_wall_contact_kind)
+{
+    scene a;
+    piston_scene(&a, "cg");
+    CHECK_OK(odhs_stepper_run_until_time(a.st, 3.0));
+    const odhs_network *net = odhs_stepper_network(a.st);
+    size_t nwall = 0;
+    for (size_t k = 0; k < odhs_network_count(net); ++k) {
+        size_t i, j;
+        int kind;
+        CHECK_OK(odhs_network_get_contact(net, k, &i, &j, &kind));
+        ck_assert_msg((j >= NP) == (kind == ODHS_CONTACT_WALL), "contact (%zu,%zu) of kind %d", i, j, kind);
+        nwall += j >= NP;
+    }
+    ck_assert_msg(nwall > 0, "no wall contact at t = 3");
+    char path[] = "/tmp/odhs_walls_kind_XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert(fd >= 0);
+    close(fd);
+    CHECK_OK(odhs_checkpoint_write(a.st, path));
+    CHECK_OK(odhs_stepper_run_until_time(a.st, 5.0));
+    odhs_solver *sol;
+    odhs_system *sys;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    char err[256];
+    CHECK_OK(odhs_solver_create_by_name("cg", &sol));
+    ck_assert_msg(odhs_checkpoint_read(path, sol, &sys, &drv, &st, err, sizeof err) == ODHS_OK, "%s", err);
+    CHECK_OK(odhs_stepper_run_until_time(st, 5.0));
+    double xa[2 * NP], xb[2 * NP];
+    CHECK_OK(odhs_system_get_positions(a.sys, xa));
+    CHECK_OK(odhs_system_get_positions(sys, xb));
+    ck_assert_msg(!memcmp(xa, xb, sizeof xa), "continuation after wall contacts is not bit-identical");
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+    odhs_solver_destroy(sol);
+    scene_free(&a);
+    remove(path);
+}
+END_TEST
+
 START_TEST(test_wall_errors)
 {
     double L[2] = {10, 10}, r[2] = {0.5, 0.5}, x[4] = {2, 2, 5, 5};
@@ -443,6 +488,7 @@ Suite *make_walls_suite(void)
     tcase_add_test(tc, test_piston);
     tcase_add_test(tc, test_piston_solvers_agree);
     tcase_add_test(tc, test_walls_checkpoint);
+    tcase_add_test(tc, test_wall_contact_kind);
     tcase_add_test(tc, test_wall_errors);
     tcase_add_test(tc, test_walls_feature_cost);
     suite_add_tcase(s, tc);

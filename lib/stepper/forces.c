@@ -15,7 +15,8 @@ void odhs__st_set_gradient(odhs_stepper *st, double c_eff)
 
 int odhs__st_add_contact(odhs_stepper *st, size_t i, size_t j, size_t *c)
 {
-    *c = odhs__net_add(st->net, i, j, ODHS_CONTACT_TEMPORARY);
+    /* a particle meeting wall j - n makes a wall contact */
+    *c = odhs__net_add(st->net, i, j, j >= st->n ? ODHS_CONTACT_WALL : ODHS_CONTACT_TEMPORARY);
     if (*c == SIZE_MAX || odhs__st_record_change(st, i, j, +1)) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     return ODHS_OK;
 }
