@@ -46,7 +46,9 @@ static int driver_update(odhs_stepper *st, step_undo *u, odhs_event *first, int 
     odhs__prop_switch(st->drv, st->time, st->lambda);
     if ((s = odhs__st_external_forces(st)) || (s = odhs__st_rewire(st))) return s;
     st->drv_version = st->drv->version;
-    if (!st->nchg) return ODHS_OK;
+    /* without events the step starts from the re-solved forces and flow: a
+     * step the scheme repeats shorter returns to them, not to the old ones */
+    if (!st->nchg) return odhs__st_save(st);
     st->nsteps++;
     *done = 1;
     return odhs__st_emit_events(st, first, stop);
