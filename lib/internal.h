@@ -15,5 +15,6 @@
 #include "jamming/jamming.h"
 #include "driver/driver.h"
 #include "stepper/stepper.h"
+#include "io/ckpt.h"
 
 #endif /* ODHS_INTERNAL_H */

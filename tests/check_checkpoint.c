@@ -239,6 +239,17 @@ END_TEST
 START_TEST(test_bit_identical_gravity_shear_2d) { run_and_compare(2, ODHS_INTEGRATOR_EULER, "dense", RC_GRAVITY); }
 END_TEST
 
+/* the bytes of the file at path (malloc'ed) */
+static unsigned char *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    ck_assert_ptr_nonnull(f);
+    unsigned char *buf = malloc(1 << 20);
+    *len = fread(buf, 1, 1 << 20, f);
+    fclose(f);
+    return buf;
+}
+
 /* a small valid checkpoint in memory */
 static unsigned char *make_ckpt_ex(size_t *len, odhs_solver **solp, int propulsion)
 {
@@ -264,11 +275,7 @@ static unsigned char *make_ckpt_ex(size_t *len, odhs_solver **solp, int propulsi
     char path[128];
     snprintf(path, sizeof path, "%s/small.ckpt", dir);
     ck_assert_int_eq(odhs_checkpoint_write(st, path), ODHS_OK);
-    FILE *f = fopen(path, "rb");
-    ck_assert_ptr_nonnull(f);
-    unsigned char *buf = malloc(1 << 20);
-    *len = fread(buf, 1, 1 << 20, f);
-    fclose(f);
+    unsigned char *buf = slurp(path, len);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_system_destroy(sys);
@@ -454,6 +461,120 @@ START_TEST(test_atomic_write)
 }
 END_TEST
 
+/* read buf, write it again: the bytes of expect (len of them) */
+static void assert_rewrites(const unsigned char *buf, size_t len, const unsigned char *expect, odhs_solver *sol)
+{
+    odhs_system *s;
+    odhs_driver *d;
+    odhs_stepper *st;
+    char err[256], path[128];
+    ck_assert_msg(odhs_checkpoint_parse(buf, len, sol, &s, &d, &st, err, sizeof err) == ODHS_OK, "%s", err);
+    snprintf(path, sizeof path, "%s/again.ckpt", dir);
+    ck_assert_int_eq(odhs_checkpoint_write(st, path), ODHS_OK);
+    size_t len2;
+    unsigned char *buf2 = slurp(path, &len2);
+    ck_assert_msg(len2 == len && !memcmp(expect, buf2, len), "read and written again, the file differs");
+    free(buf2);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(d);
+    odhs_system_destroy(s);
+}
+
+/* offset of the last occurrence of tag in buf[0..end) */
+static size_t last_tag(const unsigned char *buf, size_t end, const char *tag)
+{
+    for (size_t k = end - 4; k > 0; --k)
+        if (!memcmp(buf + k, tag, 4)) return k;
+    ck_abort_msg("section %s not found", tag);
+    return 0;
+}
+
+/* every section (WAL, CMP, PROP, GRAV, DRVC): each module writes its own,
+ * and reading and writing again gives the same bytes; the optional sections
+ * after the contacts are read in any order, each once */
+START_TEST(test_sections_round_trip)
+{
+    double L[2] = {10, 10}, r[6] = {0.5, 0.5, 0.5, 0.6, 0.6, 0.6}, x[12], cx[2] = {3, 7}, cy[2] = {4, 6};
+    for (int t = 0; t < 2; ++t)
+        for (int q = 0; q < 3; ++q) {
+            double R = 2 * r[3 * t] / sqrt(3.0), a = 2 * 3.14159265358979323846 * q / 3;
+            x[2 * (3 * t + q)] = cx[t] + R * cos(a);
+            x[2 * (3 * t + q) + 1] = cy[t] + R * sin(a);
+        }
+    odhs_system *sys;
+    odhs_driver *drv;
+    odhs_solver *sol;
+    odhs_stepper *st;
+    ck_assert_int_eq(odhs_system_create(2, 6, &sys), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_configuration(sys, L, 0, r, x), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 0.5), ODHS_OK);
+    double g[2] = {0.0, -0.3}, up[2] = {0.0, 1.0};
+    ck_assert_int_eq(odhs_driver_set_self_propulsion(drv, 6, 2, 0.1, 0.2, 0.0, 1.0, 5), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_gravity(drv, 2, g), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+    size_t b0[3] = {0, 1, 2}, b1[3] = {3, 4, 5};
+    ck_assert_int_eq(odhs_stepper_add_rigid_body(st, 3, b0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_add_chain(st, 3, b1), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_add_wall_plane(st, up, 0.5, NULL), ODHS_OK);
+    for (int k = 0; k < 10; ++k) ck_assert_int_eq(odhs_stepper_step(st, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 0.7), ODHS_OK); /* DRVC */
+    char path[128];
+    snprintf(path, sizeof path, "%s/all.ckpt", dir);
+    ck_assert_int_eq(odhs_checkpoint_write(st, path), ODHS_OK);
+    size_t len;
+    unsigned char *buf = slurp(path, &len);
+    /* the sections in the order of the format */
+    static const char *const order[] = {"SYS ", "DRV ", "STP ", "WAL ", "NET ", "CMP ", "PROP", "GRAV", "DRVC", "END "};
+    for (size_t k = 0, at = 16; k < sizeof order / sizeof order[0]; ++k) {
+        size_t t = last_tag(buf, len, order[k]);
+        ck_assert_msg(t >= at, "section %s out of order", order[k]);
+        at = t;
+    }
+    ck_assert_uint_eq(rd64(buf + 8), 2);
+    assert_rewrites(buf, len, buf, sol);
+    /* the optional sections in another order (GRAV, PROP, DRVC): the same
+     * state, written in the order of the format */
+    size_t p = last_tag(buf, len, "PROP"), q = last_tag(buf, len, "GRAV");
+    unsigned char *alt = malloc(len + 12);
+    memcpy(alt, buf, p);
+    memcpy(alt + p, buf + q, len - 12 - q - 12); /* GRAV, without DRVC */
+    memcpy(alt + p + (len - 24 - q), buf + p, q - p);
+    memcpy(alt + len - 24, buf + len - 24, 24); /* DRVC, END, checksum */
+    wr64(alt + len - 8, fnv1a(alt, len - 8));
+    assert_rewrites(alt, len, buf, sol);
+    /* a repeated and an unknown section are refused */
+    odhs_system *s2;
+    odhs_driver *d2;
+    odhs_stepper *st2;
+    char err[256];
+    static const char *const extra[] = {"DRVC", "ABCD"};
+    for (int k = 0; k < 2; ++k) {
+        memcpy(alt, buf, len - 12);
+        memcpy(alt + len - 12, extra[k], 4);
+        wr64(alt + len - 8, 1);
+        memcpy(alt + len, buf + len - 12, 4);
+        wr64(alt + len + 4, fnv1a(alt, len + 4));
+        ck_assert_int_eq(odhs_checkpoint_parse(alt, len + 12, sol, &s2, &d2, &st2, err, sizeof err), ODHS_E_FORMAT);
+        ck_assert_str_eq(err, "checkpoint: unknown or repeated section");
+    }
+    free(alt);
+    free(buf);
+    /* version 1 files (no optional section) and fixed forces */
+    odhs_solver *sol1;
+    buf = make_ckpt_ex(&len, &sol1, 0);
+    ck_assert_uint_eq(rd64(buf + 8), 1);
+    assert_rewrites(buf, len, buf, sol1);
+    free(buf);
+    odhs_solver_destroy(sol1);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+    odhs_solver_destroy(sol);
+}
+END_TEST
+
 Suite *make_checkpoint_suite(void)
 {
     Suite *s = suite_create("checkpoint");
@@ -472,6 +593,7 @@ Suite *make_checkpoint_suite(void)
     tcase_add_test(tc, test_versions);
     tcase_add_test(tc, test_truncated_and_corrupted);
     tcase_add_test(tc, test_atomic_write);
+    tcase_add_test(tc, test_sections_round_trip);
     suite_add_tcase(s, tc);
     return s;
 }
