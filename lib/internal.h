@@ -13,6 +13,7 @@
 #include "network/network.h"
 #include "solvers/solvers.h"
 #include "jamming/jamming.h"
+#include "softcore/softcore.h"
 #include "driver/driver.h"
 #include "stepper/stepper.h"
 #include "io/ckpt.h"

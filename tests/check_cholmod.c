@@ -1,5 +1,5 @@
 /*
- * libodhs - tests of the CHOLMOD backends (lib/solvers/cholmod.c):
+ * libodhs - tests of the CHOLMOD backends (lib/solvers/cholmod*.c):
  *   "cholmod"      sparse Cholesky of N = S S^T (analysis kept while the
  *                  contact list is unchanged, numeric refactorisation when only
  *                  the geometry moved);

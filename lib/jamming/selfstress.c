@@ -101,29 +101,6 @@ done:
     return st;
 }
 
-odhs_network *odhs__net_subnet(const odhs_network *net, const size_t *idx, size_t m, size_t skip)
-{
-    int d = net->dim;
-    odhs_network *sub = odhs__net_new(d, net->n);
-    if (!sub || odhs__net_copy_walls(sub, net)) goto fail;
-    if (!idx) m = net->nc;
-    for (size_t a = 0; a < m; ++a) {
-        if (a == skip) continue;
-        size_t c = idx ? idx[a] : a;
-        size_t s = odhs__net_add(sub, net->ci[c], net->cj[c], net->kind[c]);
-        if (s == SIZE_MAX) goto fail;
-        memcpy(sub->nrm + s * d, net->nrm + c * d, (size_t)d * sizeof(double));
-        sub->rest[s] = net->rest[c];
-        sub->dist[s] = net->dist[c];
-        sub->gap[s] = net->gap[c];
-    }
-    sub->version++;
-    return sub;
-fail:
-    odhs_network_destroy(sub);
-    return NULL;
-}
-
 /* f0 fixed to 1 on contact idx[k1], least squares S'^T x = -s_k1^T for the
  * others on sub, the network of idx without k1; g (n d) and x (m) are
  * scratch */

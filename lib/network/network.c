@@ -1,5 +1,6 @@
-/* libodhs - contact network, the operator S and the constrained subset. */
-#include <limits.h>
+/* libodhs - contact network: the handle, its pair hash, adding and removing
+ * contacts, geometry and detection, the operator S (S, S^T, N), bonds and
+ * walls. The constrained subset is in core.c. */
 #include <math.h>
 #include <string.h>
 
@@ -166,11 +167,7 @@ size_t odhs__net_find(const odhs_network *net, size_t i, size_t j)
     return SIZE_MAX;
 }
 
-/* ---- the constrained subset, incrementally -------------------------------
- * The constrained subset of Sect. IV D is the (d+1)-core of the contact graph:
- * the largest set of particles each with at least d+1 contacts inside it. It
- * only grows when a contact is added and only shrinks when one is removed.
- * Invariant: cdeg[x] = number of partners of x in the core, for every x. */
+/* ---- adjacency lists (partners of every particle and wall) ---------------- */
 static int adj_reserve(odhs_network *net, size_t i)
 {
     if (net->adjn[i] < net->adjcap[i]) return ODHS_OK;
@@ -191,93 +188,9 @@ static void adj_remove(odhs_network *net, size_t i, size_t j)
         }
 }
 
-/* peel core members whose core degree fell below d+1, starting from queue */
-static void core_peel(odhs_network *net, size_t qt)
-{
-    size_t need = (size_t)net->dim + 1, qh = 0, *q = net->work;
-    while (qh < qt) {
-        size_t x = q[qh++];
-        if (x >= net->n || !net->core[x] || net->cdeg[x] >= need) continue; /* walls stay */
-        net->core[x] = 0;
-        net->nbar--;
-        for (uint32_t k = 0; k < net->adjn[x]; ++k) {
-            size_t y = net->adj[x][k];
-            net->cdeg[y]--;
-            if (net->core[y]) {
-                net->ncon--;
-                /* pushed once, when its core degree first drops below d+1:
-                 * with the two seeds the queue holds at most n + 2 */
-                if (net->cdeg[y] == need - 1) q[qt++] = y;
-            }
-        }
-    }
-}
-
-/* A contact added outside the core can only make the core grow. The growth
- * is not searched for here: a search from the new contact walks the whole
- * non-core cluster (O(N) per contact, O(N^2) for a network built contact by
- * contact). The core is marked stale instead and rebuilt once, in O(N + Nc),
- * by the next query (core_ensure). The stale core stays a valid set (every
- * member keeps d+1 partners inside it), so removals keep updating it. */
-static void core_edge_added(odhs_network *net, size_t i, size_t j)
-{
-    size_t need = (size_t)net->dim + 1;
-    if (net->core[i] && net->core[j]) {
-        net->cdeg[i]++;
-        net->cdeg[j]++;
-        net->ncon++;
-        return;
-    }
-    if (net->core[i]) net->cdeg[j]++;
-    if (net->core[j]) net->cdeg[i]++;
-    if ((!net->core[i] && net->adjn[i] >= need) || (!net->core[j] && net->adjn[j] >= need)) net->core_stale = 1;
-}
-
-/* rebuild the core from scratch: every node in, then peel (O(N + Nc)) */
-static void core_ensure(const odhs_network *cnet)
-{
-    odhs_network *net = (odhs_network *)cnet; /* a cache: the set is a function of the contacts */
-    if (!net->core_stale) return;
-    size_t need = (size_t)net->dim + 1, nn = net->n + net->nwalls, qt = 0;
-    for (size_t x = 0; x < nn; ++x) {
-        net->core[x] = 1;
-        net->cdeg[x] = net->adjn[x];
-        if (x < net->n && net->cdeg[x] < need) net->work[qt++] = x;
-    }
-    net->nbar = net->n;
-    net->ncon = net->nc;
-    core_peel(net, qt);
-    net->core_stale = 0;
-}
-
-static void core_edge_removed(odhs_network *net, size_t i, size_t j)
-{
-    if (net->core[i] && net->core[j]) {
-        net->ncon--;
-        net->cdeg[i]--;
-        net->cdeg[j]--;
-        net->work[0] = i;
-        net->work[1] = j;
-        core_peel(net, 2);
-        return;
-    }
-    if (net->core[i]) net->cdeg[j]--;
-    if (net->core[j]) net->cdeg[i]--;
-}
-
-/* the body-level subset's arrays, allocated once, with the first bond */
-static int bc_reserve(odhs_network *net)
-{
-    size_t n = net->n ? net->n : 1;
-    if (!net->bcore && !(net->bcore = odhs__malloc_array(n, 1))) return ODHS_E_NOMEM;
-    if (!net->bc_in && !(net->bc_in = odhs__malloc_array(n, 1))) return ODHS_E_NOMEM;
-    if (!net->bc_mem && !(net->bc_mem = odhs__malloc_array(8 * n + 2, sizeof *net->bc_mem))) return ODHS_E_NOMEM;
-    return ODHS_OK;
-}
-
 size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
 {
-    if (kind == ODHS_CONTACT_PERMANENT && bc_reserve(net)) return SIZE_MAX;
+    if (kind == ODHS_CONTACT_PERMANENT && odhs__net_body_reserve(net)) return SIZE_MAX;
     if (i > j) {
         size_t t = i;
         i = j;
@@ -300,7 +213,7 @@ size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
     net->hval[s] = c;
     net->adj[i][net->adjn[i]++] = j;
     net->adj[j][net->adjn[j]++] = i;
-    core_edge_added(net, i, j);
+    odhs__net_core_added(net, i, j);
     net->version++;
     net->topo++;
     return c;
@@ -339,7 +252,7 @@ void odhs__net_remove_at(odhs_network *net, size_t k)
     hash_delete(net, pair_key(net, net->ci[k], net->cj[k]));
     adj_remove(net, net->ci[k], net->cj[k]);
     adj_remove(net, net->cj[k], net->ci[k]);
-    core_edge_removed(net, net->ci[k], net->cj[k]);
+    odhs__net_core_removed(net, net->ci[k], net->cj[k]);
     if (net->kind[k] == ODHS_CONTACT_PERMANENT) net->nperm--;
     size_t last = net->nc - 1;
     if (k != last) {
@@ -680,171 +593,6 @@ int odhs_network_coordination(const odhs_network *net, double *z)
     return ODHS_OK;
 }
 
-/* ---- the constrained subset with composite bodies -------------------------
- * With permanent contacts the unit of the (d+1)-core is a body: a connected
- * component of the permanent-contact graph (a single particle otherwise). A
- * body of k beads held by p permanent (and q internal temporary) contacts has
- * dof = d k - p - q degrees of freedom (at least those of a rigid body: d for a
- * single particle, 3 in 2D and 5 (dimer) or 6 in 3D otherwise) and needs dof + 1
- * contacts with other constrained bodies; a particle is the case k = 1, dof =
- * d. Removal is iterated to a fixed point as for particles. Counts in integers.
- * Recomputed from scratch (O(N + Nc)) when the network changed: only scenes
- * with permanent contacts pay for it. */
-static size_t uf_find(size_t *parent, size_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
-int odhs__net_body_core(const odhs_network *cnet)
-{
-    odhs_network *net = (odhs_network *)cnet; /* cache only */
-    if (net->bc_valid && net->bc_topo == net->topo) return ODHS_OK;
-    net->work_composite++;
-    size_t n = net->n, d = (size_t)net->dim;
-    /* scratch allocated with the first bond (bc_reserve), so that queries
-     * never allocate: parent, bid, start (n+1), beads, kb, dof, cnt, queue */
-    if (!net->bcore || !net->bc_mem || !net->bc_in) return ODHS_E_INTERNAL;
-    size_t *mem = net->bc_mem;
-    unsigned char *in = net->bc_in;
-    size_t *parent = mem, *bid = mem + n, *start = mem + 2 * n, *beads = mem + 3 * n + 1;
-    size_t *kb = mem + 4 * n + 1, *dof = mem + 5 * n + 1, *cnt = mem + 6 * n + 1, *q = mem + 7 * n + 1;
-    for (size_t i = 0; i < n; ++i) parent[i] = i;
-    for (size_t c = 0; c < net->nc; ++c)
-        if (net->kind[c] == ODHS_CONTACT_PERMANENT) {
-            size_t a = uf_find(parent, net->ci[c]), b = uf_find(parent, net->cj[c]);
-            if (a != b) parent[a < b ? b : a] = a < b ? a : b;
-        }
-    size_t nb = 0;
-    for (size_t i = 0; i < n; ++i) {
-        size_t r = uf_find(parent, i);
-        bid[i] = r == i ? nb++ : bid[r]; /* roots are the smallest index of their body */
-    }
-    for (size_t b = 0; b <= nb; ++b) start[b] = 0;
-    for (size_t b = 0; b < nb; ++b) kb[b] = dof[b] = cnt[b] = 0;
-    for (size_t i = 0; i < n; ++i) start[bid[i] + 1]++;
-    for (size_t b = 0; b < nb; ++b) start[b + 1] += start[b];
-    for (size_t i = 0; i < n; ++i) beads[start[bid[i]] + kb[bid[i]]++] = i;
-    /* constraints inside each body (permanent + internal temporary) and
-     * contacts to other bodies */
-    size_t *inner = q; /* reused as the queue afterwards */
-    for (size_t b = 0; b < nb; ++b) inner[b] = 0;
-    for (size_t c = 0; c < net->nc; ++c) {
-        if (net->cj[c] >= n) { /* a wall: never leaves the subset */
-            cnt[bid[net->ci[c]]]++;
-            continue;
-        }
-        size_t a = bid[net->ci[c]], b = bid[net->cj[c]];
-        if (a == b) inner[a]++;
-        else {
-            cnt[a]++;
-            cnt[b]++;
-        }
-    }
-    for (size_t b = 0; b < nb; ++b) {
-        size_t k = kb[b], lo = k == 1 ? d : (d == 2 ? 3 : (k == 2 ? 5 : 6));
-        size_t f = d * k > inner[b] ? d * k - inner[b] : 0;
-        dof[b] = f > lo ? f : lo;
-    }
-    size_t qt = 0, qh = 0;
-    for (size_t b = 0; b < nb; ++b) {
-        in[b] = 1;
-        if (cnt[b] < dof[b] + 1) {
-            in[b] = 2; /* queued */
-            q[qt++] = b;
-        }
-    }
-    while (qh < qt) {
-        size_t b = q[qh++];
-        in[b] = 0;
-        for (size_t p = start[b]; p < start[b + 1]; ++p) {
-            size_t x = beads[p];
-            for (uint32_t k = 0; k < net->adjn[x]; ++k) {
-                if (net->adj[x][k] >= n) continue; /* walls */
-                size_t o = bid[net->adj[x][k]];
-                if (o == b || in[o] != 1) continue;
-                if (--cnt[o] < dof[o] + 1) {
-                    in[o] = 2;
-                    q[qt++] = o;
-                }
-            }
-        }
-    }
-    size_t nbar = 0, ncon = 0;
-    for (size_t i = 0; i < n; ++i) {
-        net->bcore[i] = in[bid[i]] == 1;
-        nbar += net->bcore[i];
-    }
-    for (size_t c = 0; c < net->nc; ++c)
-        ncon += net->bcore[net->ci[c]] && (net->cj[c] >= n || net->bcore[net->cj[c]]);
-    net->bnbar = nbar;
-    net->bncon = ncon;
-    net->bc_valid = 1;
-    net->bc_topo = net->topo;
-    return ODHS_OK;
-}
-
-int odhs_network_constrained(const odhs_network *net, size_t *nbar, size_t *ncon,
-                             unsigned char *in_subset, long *zbar_num)
-{
-    if (!net) return ODHS_E_NULL;
-    core_ensure(net);
-    size_t nb = net->nbar, nk = net->ncon;
-    const unsigned char *core = net->core;
-    if (net->nperm) {
-        int st = odhs__net_body_core(net);
-        if (st) return odhs__neterr(net, st, "out of memory");
-        nb = net->bnbar;
-        nk = net->bncon;
-        core = net->bcore;
-    }
-    if (nbar) *nbar = nb;
-    if (ncon) *ncon = nk;
-    if (zbar_num) *zbar_num = nb ? 2L * (net->dim - 1) + 2L * (long)nk : 0;
-    if (in_subset) memcpy(in_subset, core, net->n);
-    return ODHS_OK;
-}
-
-int odhs_network_rattlers(const odhs_network *net, unsigned char *is_rattler, size_t *count)
-{
-    if (!net) return ODHS_E_NULL;
-    size_t nbar;
-    int st = odhs_network_constrained(net, &nbar, NULL, is_rattler, NULL);
-    if (st) return st;
-    if (is_rattler)
-        for (size_t i = 0; i < net->n; ++i) is_rattler[i] = !is_rattler[i];
-    if (count) *count = net->n - nbar;
-    return ODHS_OK;
-}
-
-int odhs__net_excess(const odhs_network *net, long *excess)
-{
-    core_ensure(net);
-    size_t nb = net->nbar, nk = net->ncon;
-    if (net->nperm) {
-        int st = odhs_network_constrained(net, &nb, &nk, NULL, NULL);
-        if (st) return st;
-    }
-    /* isostatic: d Nbar - (global zero modes) constraints; one more is a
-     * self-stress. Without walls the zero modes are the d translations. */
-    *excess = nb == 0 ? LONG_MIN : (long)(nk + net->free_modes) - (long)((size_t)net->dim * nb);
-    return ODHS_OK;
-}
-
-int odhs_network_potentially_jammed(const odhs_network *net, int *flag)
-{
-    if (!net) return ODHS_E_NULL;
-    if (!flag) return odhs__neterr(net, ODHS_E_NULL, "output pointer is NULL");
-    long e;
-    int st = odhs__net_excess(net, &e);
-    if (st) return st;
-    *flag = e >= 1;
-    return ODHS_OK;
-}
-
 /* ---- permanent contacts with a rest length ---------------------------------- */
 int odhs_network_add_bond(odhs_network *net, size_t i, size_t j, double rest)
 {
@@ -860,7 +608,7 @@ int odhs_network_add_bond(odhs_network *net, size_t i, size_t j, double rest)
     if (k == SIZE_MAX && (k = odhs__net_add(net, i, j, ODHS_CONTACT_PERMANENT)) == SIZE_MAX)
         return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
     if (net->kind[k] != ODHS_CONTACT_PERMANENT) {
-        if (bc_reserve(net)) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+        if (odhs__net_body_reserve(net)) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
         /* a temporary contact becomes a bond: same constraint, new kind */
         net->kind[k] = ODHS_CONTACT_PERMANENT;
         net->nperm++;
@@ -963,4 +711,28 @@ int odhs__net_copy_walls(odhs_network *sub, const odhs_network *net)
         if (st) return st;
     }
     return ODHS_OK;
+}
+
+/* ---- scratch copies ------------------------------------------------------------ */
+odhs_network *odhs__net_subnet(const odhs_network *net, const size_t *idx, size_t m, size_t skip)
+{
+    int d = net->dim;
+    odhs_network *sub = odhs__net_new(d, net->n);
+    if (!sub || odhs__net_copy_walls(sub, net)) goto fail;
+    if (!idx) m = net->nc;
+    for (size_t a = 0; a < m; ++a) {
+        if (a == skip) continue;
+        size_t c = idx ? idx[a] : a;
+        size_t s = odhs__net_add(sub, net->ci[c], net->cj[c], net->kind[c]);
+        if (s == SIZE_MAX) goto fail;
+        memcpy(sub->nrm + s * d, net->nrm + c * d, (size_t)d * sizeof(double));
+        sub->rest[s] = net->rest[c];
+        sub->dist[s] = net->dist[c];
+        sub->gap[s] = net->gap[c];
+    }
+    sub->version++;
+    return sub;
+fail:
+    odhs_network_destroy(sub);
+    return NULL;
 }

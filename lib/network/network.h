@@ -71,7 +71,7 @@ int odhs__net_copy_walls(odhs_network *sub, const odhs_network *net);
 /* a scratch network with net's walls and its contacts idx[0..m-1] (every
  * contact if idx is NULL), leaving out position `skip` of that list
  * (SIZE_MAX: none), kinds, rest lengths and geometry copied; NULL when out
- * of memory (lib/jamming.c) */
+ * of memory */
 odhs_network *odhs__net_subnet(const odhs_network *net, const size_t *idx, size_t m, size_t skip);
 /* whether particles i and j belong to the same rigid body */
 static inline int odhs__same_body(const odhs_network *net, size_t i, size_t j)
@@ -80,6 +80,12 @@ static inline int odhs__same_body(const odhs_network *net, size_t i, size_t j)
 }
 /* body-aware constrained subset (only when nperm > 0): fills bcore, bnbar, bncon */
 int odhs__net_body_core(const odhs_network *net);
+/* the constrained subset after contact (i, j) was added to / removed from
+ * the adjacency lists (lib/network/core.c) */
+void odhs__net_core_added(odhs_network *net, size_t i, size_t j);
+void odhs__net_core_removed(odhs_network *net, size_t i, size_t j);
+/* the body-level subset's scratch, allocated once, with the first bond */
+int odhs__net_body_reserve(odhs_network *net);
 
 odhs_network *odhs__net_new(int dim, size_t n);
 int odhs__neterr(const odhs_network *net, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);

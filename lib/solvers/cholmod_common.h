@@ -1,0 +1,47 @@
+/*
+ * libodhs private header: what the two CHOLMOD backends ("cholmod" in
+ * cholmod.c, "cholmod-pcg" in cholmod_pcg.c) share (cholmod_common.c).
+ * Include only under ODHS_HAVE_SUITESPARSE. Not installed.
+ *
+ * Every backend state owns its own cholmod_common (cholmod_start /
+ * cholmod_finish); CHOLMOD's printing is switched off (Common->print = 0):
+ * problems are reported through status codes only. The int interface of
+ * CHOLMOD is used throughout (sizes beyond INT_MAX give ODHS_E_NOMEM).
+ */
+#ifndef ODHS_SOLVERS_CHOLMOD_COMMON_H
+#define ODHS_SOLVERS_CHOLMOD_COMMON_H
+
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#endif
+#include <cholmod.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+#include "solvers/solvers.h"
+
+/* status of a failed CHOLMOD call */
+int odhs__cm_error(const cholmod_common *c);
+/* cholmod_start with printing and the error handler off */
+void odhs__cm_start(cholmod_common *c);
+/* Whether the network's sizes fit CHOLMOD's int interface for a matrix
+ * [S | E] with nextra extra unit columns. */
+int odhs__cm_fits_int(const odhs_network *net, size_t nextra);
+/* (Re)allocate A (nrow x ncol, CSC, packed, sorted, unsymmetric) unless the
+ * current one has exactly these dimensions and nonzero count. */
+int odhs__cm_ensure_sparse(cholmod_sparse **A, size_t nrow, size_t ncol, size_t nnz, cholmod_common *c);
+/* (Re)allocate the dense column B unless it has nrow rows already. */
+int odhs__cm_ensure_dense(cholmod_dense **B, size_t nrow, cholmod_common *c);
+/* A = [S | E] in compressed columns (nextra unit columns E); cnt: n entries
+ * of workspace. */
+void odhs__cm_fill_S(const odhs_network *net, size_t nextra, cholmod_sparse *A, size_t *cnt);
+/* Smallest and largest pivot of a simplicial factor (0 for a supernodal one). */
+int odhs__cm_simplicial_pivots(const cholmod_factor *L, double *dmin, double *dmax);
+/* Number of stored entries of L. */
+double odhs__cm_factor_nnz(const cholmod_factor *L, const cholmod_common *c);
+/* Check a fresh numeric factorisation: ODHS_OK, ODHS_E_SINGULAR or an error. */
+int odhs__cm_check_factor(cholmod_factor *L, cholmod_common *c, double min_rcond, double *rcond);
+
+#endif /* ODHS_SOLVERS_CHOLMOD_COMMON_H */

@@ -1,0 +1,630 @@
+/*
+ * libodhs - sparse solver for N = S S^T through CHOLMOD (SuiteSparse): the
+ * backend "cholmod-pcg" ("cholmod" is in cholmod.c, what both share in
+ * cholmod_common.c), compiled only when the Makefile finds SuiteSparse
+ * (ODHS_HAVE_SUITESPARSE); otherwise this file defines nothing.
+ *
+ * "cholmod-pcg" (odhs_solver_type_cholmod_pcg): preconditioned conjugate
+ *   gradients on N x = b (matrix free, as the "cg" backend) with a simplicial
+ *   LDL' factor of a "slot" matrix M as the preconditioner, kept up to date
+ *   through CHOLMOD's Modify module when contacts appear or disappear:
+ *   - the factor has a fixed size cap >= Nc (cap = Nc + max(16, Nc/8) at each
+ *     full factorisation); every contact pair occupies a stable slot, free
+ *     slots are identity rows and columns of M. Contacts are found again by
+ *     their pair (i,j) through the network's own pair hash (odhs__net_find),
+ *     so the swap-removal that renumbers contacts does not matter: a contact
+ *     -> slot map is rebuilt at each setup in O(cap).
+ *   - a removed contact: cholmod_rowdel on its slot (row/column -> identity);
+ *     an added contact: cholmod_rowadd with the full new row of M (the row of
+ *     N for this contact against the contacts already in the factor, computed
+ *     with the current normals, plus the diagonal 2|n|^2). Both work on the
+ *     permuted factor, so slot s is row/column Pinv[s] of L and the entries of
+ *     the new row are given at permuted positions. rowadd requires the row to
+ *     be an identity row on input, which free slots are.
+ *     (cholmod_updown was the alternative: N changes by a row and a column,
+ *     which is a rank-2 symmetric change of M; rowadd/rowdel do exactly that
+ *     change and keep the factor's dimension, so they are the natural fit.)
+ *   - the backend remembers the normal each row of the factor was made with.
+ *     While no normal of a contact in the factor has moved (e.g. inside the
+ *     stepper's rewiring, which removes and re-adds contacts at a fixed
+ *     geometry) the updated factor is the exact LDL' of N and PCG converges in
+ *     one iteration. Once normals moved, the factor belongs to an older
+ *     geometry and PCG makes up the difference (about 5 iterations at 1e-12
+ *     after one step of a sheared packing).
+ *   - full refactorisation (slots renumbered 0..Nc-1, new analysis unless
+ *     only the geometry changed since the last one) after "refactor_every"
+ *     geometry changes (setups at which some normal had moved since the
+ *     previous setup; default 50; 0 = never for this reason), when the slot
+ *     capacity would be exceeded, when many contacts changed at once (more
+ *     than (Nc + 64)/8: cheaper than updates), when the updates have doubled
+ *     the fill of L, when an update leaves a D entry not above
+ *     min_rcond * max(D) (a mixed-geometry matrix need not stay positive
+ *     definite, and a new contact can make N singular), and inside solve when
+ *     PCG with an aged factor needs more than "refactor_iterations" (default
+ *     40) iterations or breaks down: the solve then goes on from its current
+ *     iterate with the fresh factor. A fresh factor that fails is
+ *     ODHS_E_SINGULAR, as for "cholmod".
+ *   Parameters: "tol" (relative residual, default 1e-12), "maxiter" (default
+ *   0 = 10*Nc + 100), "min_rcond" (1e-14), "refactor_every" (50),
+ *   "refactor_iterations" (40), "supernodal" (only 0 is accepted: the Modify
+ *   module needs a simplicial LDL' factor). Statistics: "iterations" (of the
+ *   last solve), "updates" (rowadd + rowdel calls), "factorizations",
+ *   "analyses", "rcond" (of the last full factorisation), "nnz_L" (current),
+ *   "flops", "capacity" (slots), "cholmod_status".
+ *
+ * As for both backends (cholmod_common.h): each state owns its own
+ * cholmod_common, CHOLMOD never prints, and its int interface is used.
+ *
+ * Licence note: cholmod_rowadd/cholmod_rowdel belong to CHOLMOD's Modify
+ * module, which is GPL-2.0+ (CHOLMOD's Core and Cholesky modules are
+ * LGPL-2.1+). The "cholmod-pcg" backend therefore pulls GPL code into a
+ * build that links it.
+ */
+#ifdef ODHS_HAVE_SUITESPARSE
+
+#include <math.h>
+#include <string.h>
+
+#include "solvers/cholmod_common.h"
+
+ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
+
+#define NO_SLOT SIZE_MAX
+
+typedef struct {
+    cholmod_common c;
+    cholmod_sparse *A;        /* [S | E] of the last full factorisation */
+    cholmod_factor *L;        /* simplicial LDL' of the slot matrix M */
+    cholmod_sparse *R;        /* cap x 1: new row for rowadd */
+    cholmod_dense *B, *X, *Y, *E;
+    size_t cap;               /* slots = dimension of L */
+    size_t *si, *sj;          /* pair held by each slot, NO_SLOT if free */
+    size_t *freel, nfree;     /* stack of free slots */
+    int *pinv;                /* slot -> row of the permuted factor */
+    size_t slotcap;           /* allocated length of si, sj, freel, pinv, dels */
+    size_t *dels;             /* slots to delete (setup workspace) */
+    size_t *c2s, c2scap;      /* contact -> slot for the last setup */
+    uint32_t *seen, stamp;    /* per slot: matched in the setup with this stamp */
+    size_t seencap;
+    size_t nc;                /* contacts at the last setup */
+    size_t n;
+    int dim;
+    size_t *cnt, *start, *inc; /* particle -> incident contacts */
+    size_t cntcap, startcap, inccap;
+    double *w;
+    size_t wcap;
+    int valid;                /* factor and slot map describe the last setup */
+    double *snrm;             /* cap*dim: normal each slot's row was made with */
+    double *lnrm;             /* cap*dim: normal of each slot at the last setup */
+    size_t snrmcap, lnrmcap;
+    int fresh;                /* the factor is exact for the current N */
+    size_t since;             /* geometry changes since the last full factorisation */
+    size_t updates_since_analysis;
+    double nnz0;              /* nnz(L) right after the last full factorisation */
+    /* parameters */
+    double tol, maxiter, min_rcond, refactor_every, refactor_iterations;
+    /* statistics */
+    double iterations, updates, factorizations, analyses, rcond, status;
+} pcg_state;
+
+static int pcg_create(void **state)
+{
+    pcg_state *s = odhs__calloc(1, sizeof *s);
+    if (!s) return ODHS_E_NOMEM;
+    odhs__cm_start(&s->c);
+    s->c.supernodal = CHOLMOD_SIMPLICIAL; /* the Modify module needs LDL' */
+    s->c.final_ll = 0;
+    s->tol = 1e-12;
+    s->min_rcond = 1e-14;
+    s->refactor_every = 50;
+    s->refactor_iterations = 40;
+    *state = s;
+    return ODHS_OK;
+}
+
+static void pcg_destroy(void *state)
+{
+    pcg_state *s = state;
+    if (!s) return;
+    cholmod_free_factor(&s->L, &s->c);
+    cholmod_free_sparse(&s->A, &s->c);
+    cholmod_free_sparse(&s->R, &s->c);
+    cholmod_free_dense(&s->B, &s->c);
+    cholmod_free_dense(&s->X, &s->c);
+    cholmod_free_dense(&s->Y, &s->c);
+    cholmod_free_dense(&s->E, &s->c);
+    cholmod_finish(&s->c);
+    odhs__free(s->si);
+    odhs__free(s->sj);
+    odhs__free(s->freel);
+    odhs__free(s->pinv);
+    odhs__free(s->dels);
+    odhs__free(s->snrm);
+    odhs__free(s->lnrm);
+    odhs__free(s->c2s);
+    odhs__free(s->seen);
+    odhs__free(s->cnt);
+    odhs__free(s->start);
+    odhs__free(s->inc);
+    odhs__free(s->w);
+    odhs__free(s);
+}
+
+static int pcg_set_param(void *state, const char *key, double v)
+{
+    pcg_state *s = state;
+    if (!strcmp(key, "tol") && v > 0.0 && v < 1.0) s->tol = v;
+    else if (!strcmp(key, "maxiter") && v >= 0.0) s->maxiter = floor(v);
+    else if (!strcmp(key, "min_rcond") && v >= 0.0 && v < 1.0) s->min_rcond = v;
+    else if (!strcmp(key, "refactor_every") && v >= 0.0) s->refactor_every = floor(v);
+    else if (!strcmp(key, "refactor_iterations") && v >= 1.0) s->refactor_iterations = floor(v);
+    else if (!strcmp(key, "supernodal") && v == 0.0) { /* simplicial only */
+    } else return ODHS_E_INVALID;
+    return ODHS_OK;
+}
+
+static int pcg_get_stat(void *state, const char *key, double *v)
+{
+    pcg_state *s = state;
+    if (!strcmp(key, "iterations")) *v = s->iterations;
+    else if (!strcmp(key, "updates")) *v = s->updates;
+    else if (!strcmp(key, "factorizations")) *v = s->factorizations;
+    else if (!strcmp(key, "analyses")) *v = s->analyses;
+    else if (!strcmp(key, "rcond")) *v = s->rcond;
+    else if (!strcmp(key, "nnz_L")) *v = odhs__cm_factor_nnz(s->L, &s->c);
+    else if (!strcmp(key, "flops")) *v = s->L ? s->c.fl : 0.0;
+    else if (!strcmp(key, "capacity")) *v = (double)s->cap;
+    else if (!strcmp(key, "cholmod_status")) *v = s->status;
+    else if (!strcmp(key, "tol")) *v = s->tol;
+    else return ODHS_E_INVALID;
+    return ODHS_OK;
+}
+
+static size_t pcg_extra(size_t nc) { return nc / 8 > 16 ? nc / 8 : 16; }
+
+/* slot arrays (si, sj, freel, pinv, dels) for at least cap slots */
+static int pcg_slot_arrays(pcg_state *s, size_t cap)
+{
+    if (s->slotcap >= cap) return ODHS_OK;
+    size_t nc = cap + cap / 4;
+    void *a = odhs__realloc(s->si, nc * sizeof *s->si);
+    if (a) s->si = a;
+    void *b = odhs__realloc(s->sj, nc * sizeof *s->sj);
+    if (b) s->sj = b;
+    void *c = odhs__realloc(s->freel, nc * sizeof *s->freel);
+    if (c) s->freel = c;
+    void *d = odhs__realloc(s->pinv, nc * sizeof *s->pinv);
+    if (d) s->pinv = d;
+    void *e = odhs__realloc(s->dels, nc * sizeof *s->dels);
+    if (e) s->dels = e;
+    if (!a || !b || !c || !d || !e) return ODHS_E_NOMEM;
+    s->slotcap = nc;
+    return ODHS_OK;
+}
+
+/* Full factorisation of M for the network's current contacts and geometry:
+ * slots 0..Nc-1 hold the contacts in network order, the others are free.
+ * The symbolic analysis is reused when nothing but the geometry changed
+ * since it was made. */
+static int pcg_full(pcg_state *s, const odhs_network *net)
+{
+    size_t nc = net->nc, n = net->n, extra = pcg_extra(nc), cap = nc + extra;
+    size_t nd = n * (size_t)net->dim;
+    int st;
+    s->valid = 0;
+    if (!odhs__cm_fits_int(net, extra)) return ODHS_E_NOMEM;
+    if ((st = pcg_slot_arrays(s, cap))) return st;
+    if ((st = odhs__reserve((void **)&s->c2s, &s->c2scap, nc, sizeof *s->c2s))) return st;
+    if ((st = odhs__reserve((void **)&s->cnt, &s->cntcap, n + 1, sizeof *s->cnt))) return st;
+    if ((st = odhs__reserve((void **)&s->snrm, &s->snrmcap, cap * (size_t)net->dim, sizeof *s->snrm)) ||
+        (st = odhs__reserve((void **)&s->lnrm, &s->lnrmcap, cap * (size_t)net->dim, sizeof *s->lnrm)))
+        return st;
+
+    int numeric_only = s->L && s->updates_since_analysis == 0 && s->cap == cap && s->n == n &&
+                       s->dim == net->dim;
+    for (size_t c = 0; numeric_only && c < nc; ++c)
+        if (s->si[c] != net->ci[c] || s->sj[c] != net->cj[c]) numeric_only = 0;
+
+    if ((st = odhs__cm_ensure_sparse(&s->A, cap, nd + extra, 2 * (size_t)net->dim * nc + extra, &s->c))) return st;
+    odhs__cm_fill_S(net, extra, s->A, s->cnt);
+    if (!numeric_only) {
+        cholmod_free_factor(&s->L, &s->c);
+        s->L = cholmod_analyze(s->A, &s->c);
+        s->status = s->c.status;
+        if (!s->L) return odhs__cm_error(&s->c);
+        s->analyses += 1.0;
+        s->updates_since_analysis = 0;
+        const int *perm = s->L->Perm;
+        for (size_t k = 0; k < cap; ++k) s->pinv[perm[k]] = (int)k;
+        /* slots: contacts in network order, the rest free */
+        s->cap = cap;
+        s->n = n;
+        s->dim = net->dim;
+        for (size_t c = 0; c < nc; ++c) {
+            s->si[c] = net->ci[c];
+            s->sj[c] = net->cj[c];
+        }
+        s->nfree = 0;
+        for (size_t t = cap; t-- > nc;) {
+            s->si[t] = s->sj[t] = NO_SLOT;
+            s->freel[s->nfree++] = t;
+        }
+    }
+    for (size_t c = 0; c < nc; ++c) s->c2s[c] = c;
+    memcpy(s->snrm, net->nrm, nc * (size_t)net->dim * sizeof *s->snrm);
+    memcpy(s->lnrm, net->nrm, nc * (size_t)net->dim * sizeof *s->lnrm);
+    s->nc = nc;
+    int ok = cholmod_factorize(s->A, s->L, &s->c);
+    s->status = s->c.status;
+    s->factorizations += 1.0;
+    s->since = 0;
+    if (!ok || s->c.status < 0) {
+        st = odhs__cm_error(&s->c);
+        cholmod_free_factor(&s->L, &s->c);
+        return st;
+    }
+    if ((st = odhs__cm_check_factor(s->L, &s->c, s->min_rcond, &s->rcond))) return st;
+    if (s->L->is_super || s->L->is_ll) return ODHS_E_INTERNAL; /* Modify needs LDL' */
+    s->nnz0 = odhs__cm_factor_nnz(s->L, &s->c);
+    s->valid = 1;
+    s->fresh = 1;
+    return ODHS_OK;
+}
+
+/* particle -> incident contacts of the network (CSR in start/inc) */
+static int pcg_incidence(pcg_state *s, const odhs_network *net)
+{
+    size_t n = net->n, nc = net->nc;
+    int st;
+    if ((st = odhs__reserve((void **)&s->start, &s->startcap, n + 1, sizeof *s->start)) ||
+        (st = odhs__reserve((void **)&s->inc, &s->inccap, 2 * nc, sizeof *s->inc)))
+        return st;
+    size_t *start = s->start, *inc = s->inc;
+    memset(start, 0, (n + 1) * sizeof *start);
+    for (size_t c = 0; c < nc; ++c) {
+        start[net->ci[c] + 1]++;
+        if (net->cj[c] < n) start[net->cj[c] + 1]++;
+    }
+    for (size_t p = 0; p < n; ++p) start[p + 1] += start[p];
+    for (size_t c = 0; c < nc; ++c) {
+        inc[start[net->ci[c]]++] = c;
+        if (net->cj[c] < n) inc[start[net->cj[c]]++] = c;
+    }
+    for (size_t p = n; p > 0; --p) start[p] = start[p - 1];
+    start[0] = 0;
+    return ODHS_OK;
+}
+
+/* Add contact c into the free slot t: R = row of M for c against the contacts
+ * already in the factor (c2s != NO_SLOT), at permuted positions. */
+static int pcg_rowadd(pcg_state *s, const odhs_network *net, size_t c, size_t t)
+{
+    int d = net->dim;
+    const double *nc_ = net->nrm + c * d;
+    int *Ri = s->R->i, *Rp = s->R->p;
+    double *Rx = s->R->x;
+    size_t nz = 0;
+    double dd = 0.0;
+    for (int k = 0; k < d; ++k) dd += nc_[k] * nc_[k];
+    Ri[nz] = s->pinv[t];
+    Rx[nz++] = (net->cj[c] < net->n ? 2.0 : 1.0) * dd; /* a wall contact has one block */
+    size_t ends[2] = {net->ci[c], net->cj[c]};
+    for (int e = 0; e < 2; ++e) {
+        size_t p = ends[e];
+        if (p >= net->n) continue; /* a wall */
+        double sc = p == net->ci[c] ? -1.0 : 1.0;
+        for (size_t u = s->start[p]; u < s->start[p + 1]; ++u) {
+            size_t c2 = s->inc[u];
+            if (c2 == c || s->c2s[c2] == NO_SLOT) continue;
+            double s2 = p == net->ci[c2] ? -1.0 : 1.0;
+            const double *n2 = net->nrm + c2 * d;
+            double dot = 0.0;
+            for (int k = 0; k < d; ++k) dot += nc_[k] * n2[k];
+            Ri[nz] = s->pinv[s->c2s[c2]];
+            Rx[nz++] = sc * s2 * dot;
+        }
+    }
+    Rp[0] = 0;
+    Rp[1] = (int)nz;
+    s->R->sorted = 0;
+    memcpy(s->snrm + t * d, nc_, (size_t)d * sizeof *nc_);
+    memcpy(s->lnrm + t * d, nc_, (size_t)d * sizeof *nc_);
+    int ok = cholmod_rowadd((size_t)s->pinv[t], s->R, s->L, &s->c);
+    s->status = s->c.status;
+    s->updates += 1.0;
+    s->updates_since_analysis++;
+    return ok && s->c.status >= 0 ? ODHS_OK : odhs__cm_error(&s->c);
+}
+
+/* per-slot stamps for this setup: seen[t] == stamp marks a matched slot */
+static int pcg_stamp(pcg_state *s)
+{
+    if (s->seencap < s->cap) {
+        uint32_t *m = odhs__calloc(s->cap, sizeof *m);
+        if (!m) return ODHS_E_NOMEM;
+        odhs__free(s->seen);
+        s->seen = m;
+        s->seencap = s->cap;
+        s->stamp = 0;
+    }
+    if (++s->stamp == 0) {
+        memset(s->seen, 0, s->seencap * sizeof *s->seen);
+        s->stamp = 1;
+    }
+    return ODHS_OK;
+}
+
+/* Match slots to contacts by their pair: c2s for every contact (NO_SLOT: not
+ * in the factor yet), the slots of contacts that are gone into dels; returns
+ * their number. A contact keeps its index unless a removal moved the last one
+ * into its place, so the slot of the last setup is checked first (a
+ * sequential pass); only the slots left over are looked up in the network's
+ * pair hash (random access, which costs cache misses once the table outgrows
+ * the cache: at N ~ 3000 a lookup per slot and setup took 12% of a shear
+ * run). */
+static size_t pcg_match(pcg_state *s, const odhs_network *net)
+{
+    size_t nc = net->nc, pnc = s->nc;
+    for (size_t c = 0; c < nc; ++c) {
+        size_t t = c < pnc ? s->c2s[c] : NO_SLOT;
+        if (t != NO_SLOT && t < s->cap && s->si[t] == net->ci[c] && s->sj[t] == net->cj[c]) s->seen[t] = s->stamp;
+        else s->c2s[c] = NO_SLOT;
+    }
+    size_t ndel = 0;
+    for (size_t t = 0; t < s->cap; ++t) {
+        if (s->si[t] == NO_SLOT || s->seen[t] == s->stamp) continue;
+        size_t k = odhs__net_find(net, s->si[t], s->sj[t]);
+        if (k == SIZE_MAX) {
+            s->dels[ndel++] = t;
+            continue;
+        }
+        s->c2s[k] = t;
+    }
+    return ndel;
+}
+
+/* did normals move since the last setup (*moved; lnrm is brought up to
+ * date), and since their rows went into the factor (*aged)? */
+static void pcg_normals(pcg_state *s, const odhs_network *net, int *moved, int *aged)
+{
+    int d = net->dim, mv = 0, ag = 0;
+    size_t bytes = (size_t)d * sizeof *net->nrm;
+    for (size_t c = 0; c < net->nc; ++c) {
+        size_t t = s->c2s[c];
+        if (t == NO_SLOT) continue;
+        const double *nk = net->nrm + c * d;
+        if (memcmp(s->lnrm + t * d, nk, bytes)) {
+            mv = 1;
+            memcpy(s->lnrm + t * d, nk, bytes);
+        }
+        if (!ag && memcmp(s->snrm + t * d, nk, bytes)) ag = 1;
+    }
+    *moved = mv;
+    *aged = ag;
+}
+
+/* cholmod_rowdel of the ndel slots in dels, which become free; 1 when an
+ * update failed (the caller refactors), else 0 */
+static int pcg_delete(pcg_state *s, size_t ndel)
+{
+    for (size_t q = 0; q < ndel; ++q) {
+        size_t t = s->dels[q];
+        int ok = cholmod_rowdel((size_t)s->pinv[t], NULL, s->L, &s->c);
+        s->status = s->c.status;
+        s->updates += 1.0;
+        s->updates_since_analysis++;
+        if (!ok || s->c.status < 0) return 1;
+        s->si[t] = s->sj[t] = NO_SLOT;
+        s->freel[s->nfree++] = t;
+    }
+    return 0;
+}
+
+/* cholmod_rowadd of every contact without a slot into a free one: ODHS_OK
+ * (*refactor = 1 when an update failed: the caller refactors) or an error */
+static int pcg_insert(pcg_state *s, const odhs_network *net, int *refactor)
+{
+    int st;
+    if ((st = pcg_incidence(s, net))) return st;
+    if (!s->R || s->R->nrow != s->cap) {
+        cholmod_free_sparse(&s->R, &s->c);
+        s->R = cholmod_allocate_sparse(s->cap, 1, s->cap, 0, 1, 0, CHOLMOD_REAL, &s->c);
+        if (!s->R) return odhs__cm_error(&s->c);
+    }
+    for (size_t c = 0; c < net->nc; ++c) {
+        if (s->c2s[c] != NO_SLOT) continue;
+        size_t t = s->freel[--s->nfree];
+        if (pcg_rowadd(s, net, c, t)) {
+            *refactor = 1;
+            return ODHS_OK;
+        }
+        s->c2s[c] = t;
+        s->si[t] = net->ci[c];
+        s->sj[t] = net->cj[c];
+    }
+    return ODHS_OK;
+}
+
+static int pcg_setup(void *state, const odhs_network *net)
+{
+    pcg_state *s = state;
+    size_t nc = net->nc;
+    int st;
+    if (!s->valid || !s->L || s->n != net->n || s->dim != net->dim) return pcg_full(s, net);
+    if ((st = odhs__reserve((void **)&s->c2s, &s->c2scap, nc, sizeof *s->c2s))) return st;
+    if ((st = pcg_stamp(s))) return st;
+    s->valid = 0; /* c2s is rewritten: until this setup went through */
+    size_t ndel = pcg_match(s, net);
+    int moved, aged;
+    pcg_normals(s, net, &moved, &aged);
+    /* an aged factor is a preconditioner only; count the geometry changes */
+    if (aged) s->fresh = 0;
+    if (moved) {
+        s->since++;
+        if (s->refactor_every > 0 && (double)s->since >= s->refactor_every) return pcg_full(s, net);
+    }
+    size_t nadd = 0;
+    for (size_t c = 0; c < nc; ++c) nadd += s->c2s[c] == NO_SLOT;
+    if (nadd > s->nfree + ndel || 8 * (nadd + ndel) > nc + 64) return pcg_full(s, net);
+    if (pcg_delete(s, ndel)) return pcg_full(s, net);
+    if (nadd) {
+        int refactor = 0;
+        if ((st = pcg_insert(s, net, &refactor))) return st;
+        if (refactor) return pcg_full(s, net);
+    }
+    s->nc = nc;
+    if (ndel + nadd) {
+        /* an updated factor of a mixed-geometry (or singular) matrix may have
+         * lost definiteness: then start afresh (which also decides whether N
+         * itself is singular); likewise when the updates doubled the fill */
+        double dmin, dmax;
+        if (!odhs__cm_simplicial_pivots(s->L, &dmin, &dmax) || !(dmin > s->min_rcond * dmax)) return pcg_full(s, net);
+        if (odhs__cm_factor_nnz(s->L, &s->c) > 2.0 * s->nnz0 + 1000.0) return pcg_full(s, net);
+    }
+    s->valid = 1;
+    return ODHS_OK;
+}
+
+/* z = M^{-1} r through the slots */
+static int pcg_precond(pcg_state *s, size_t nc, const double *r, double *z)
+{
+    /* a refactorisation inside the solve may have grown the slot capacity */
+    int st = odhs__cm_ensure_dense(&s->B, s->cap, &s->c);
+    if (st) return st;
+    double *bx = s->B->x;
+    memset(bx, 0, s->cap * sizeof *bx);
+    for (size_t c = 0; c < nc; ++c) bx[s->c2s[c]] = r[c];
+    if (!cholmod_solve2(CHOLMOD_A, s->L, s->B, NULL, &s->X, NULL, &s->Y, &s->E, &s->c)) return odhs__cm_error(&s->c);
+    const double *xx = s->X->x;
+    for (size_t c = 0; c < nc; ++c) z[c] = xx[s->c2s[c]];
+    return ODHS_OK;
+}
+
+/* PCG from the iterate x, at most limit iterations (counted in *it).
+ * ODHS_OK, ODHS_E_NOCONV, ODHS_E_SINGULAR (breakdown) or an error. */
+static int pcg_run(pcg_state *s, const odhs_network *net, const double *b, double *x, double bn,
+                   size_t limit, size_t *it)
+{
+    size_t nc = net->nc;
+    double *r = s->w, *z = r + nc, *p = z + nc, *q = p + nc, *tmp = q + nc;
+    double target = s->tol * bn;
+    int st;
+    for (int restart = 0; restart < 3; ++restart) {
+        odhs__net_N(net, x, q, tmp);
+        double rn = 0.0;
+        for (size_t c = 0; c < nc; ++c) {
+            r[c] = b[c] - q[c];
+            rn += r[c] * r[c];
+        }
+        if (sqrt(rn) <= target) return ODHS_OK;
+        if ((st = pcg_precond(s, nc, r, z))) return st;
+        double rz = 0.0;
+        for (size_t c = 0; c < nc; ++c) {
+            p[c] = z[c];
+            rz += r[c] * z[c];
+        }
+        if (!(rz > 0.0)) return ODHS_E_SINGULAR;
+        size_t k = 0;
+        while (sqrt(rn) > target) {
+            if (*it >= limit) return ODHS_E_NOCONV;
+            odhs__net_N(net, p, q, tmp);
+            double pq = 0.0;
+            for (size_t c = 0; c < nc; ++c) pq += p[c] * q[c];
+            if (!(pq > 0.0)) return ODHS_E_SINGULAR;
+            double alpha = rz / pq;
+            rn = 0.0;
+            for (size_t c = 0; c < nc; ++c) {
+                x[c] += alpha * p[c];
+                r[c] -= alpha * q[c];
+                rn += r[c] * r[c];
+            }
+            ++*it;
+            ++k;
+            if (k % 50 == 0) { /* refresh the recursive residual */
+                odhs__net_N(net, x, q, tmp);
+                rn = 0.0;
+                for (size_t c = 0; c < nc; ++c) {
+                    r[c] = b[c] - q[c];
+                    rn += r[c] * r[c];
+                }
+            }
+            if (sqrt(rn) <= target) break;
+            if ((st = pcg_precond(s, nc, r, z))) return st;
+            double rz_new = 0.0;
+            for (size_t c = 0; c < nc; ++c) rz_new += r[c] * z[c];
+            if (!(rz_new > 0.0)) return ODHS_E_SINGULAR;
+            double beta = rz_new / rz;
+            rz = rz_new;
+            for (size_t c = 0; c < nc; ++c) p[c] = z[c] + beta * p[c];
+        }
+        /* converged on the recursive residual: confirm on the true one (the
+         * loop start), restarting from x when they differ */
+    }
+    return ODHS_OK;
+}
+
+static int pcg_solve(void *state, const odhs_network *net, const double *b, double *x)
+{
+    pcg_state *s = state;
+    size_t nc = net->nc, nd = net->n * (size_t)net->dim;
+    int st;
+    s->iterations = 0.0;
+    if (!s->valid || !s->L || s->nc != nc) return ODHS_E_STATE;
+    if ((st = odhs__reserve((void **)&s->w, &s->wcap, 4 * nc + nd, sizeof *s->w))) return st;
+    if ((st = odhs__cm_ensure_dense(&s->B, s->cap, &s->c))) return st;
+    double bn = 0.0;
+    for (size_t c = 0; c < nc; ++c) bn += b[c] * b[c];
+    bn = sqrt(bn);
+    if (bn == 0.0) {
+        memset(x, 0, nc * sizeof *x);
+        return ODHS_OK;
+    }
+    for (size_t c = 0; c < nc; ++c) /* an unusable guess: start from zero */
+        if (!isfinite(x[c])) {
+            memset(x, 0, nc * sizeof *x);
+            break;
+        }
+    size_t maxit = s->maxiter > 0 ? (size_t)s->maxiter : 10 * nc + 100, it = 0;
+    size_t limit = maxit;
+    if (!s->fresh && (double)limit > s->refactor_iterations) limit = (size_t)s->refactor_iterations;
+    st = pcg_run(s, net, b, x, bn, limit, &it);
+    if (st == ODHS_E_NOCONV || st == ODHS_E_SINGULAR) {
+        if (!s->fresh) {
+            /* the aged preconditioner is not good enough: refactor at the
+             * current geometry and go on from the current iterate */
+            for (size_t c = 0; c < nc; ++c)
+                if (!isfinite(x[c])) {
+                    memset(x, 0, nc * sizeof *x);
+                    break;
+                }
+            int fs = pcg_full(s, net);
+            if (fs) {
+                s->iterations = (double)it;
+                return fs;
+            }
+            st = pcg_run(s, net, b, x, bn, maxit, &it);
+        }
+    }
+    s->iterations = (double)it;
+    return st;
+}
+
+ODHS_API const odhs_solver_type odhs_solver_type_cholmod_pcg = {
+    .version = ODHS_SOLVER_TYPE_VERSION,
+    .name = "cholmod-pcg",
+    .flags = ODHS_SOLVER_ITERATIVE | ODHS_SOLVER_USES_GUESS,
+    .create = pcg_create,
+    .destroy = pcg_destroy,
+    .setup = pcg_setup,
+    .solve = pcg_solve,
+    .set_param = pcg_set_param,
+    .get_stat = pcg_get_stat,
+    .solve_ls = NULL,
+};
+
+#else /* !ODHS_HAVE_SUITESPARSE */
+
+/* ISO C forbids an empty translation unit */
+typedef int odhs__cholmod_pcg_not_built;
+
+#endif /* ODHS_HAVE_SUITESPARSE */
