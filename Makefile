@@ -432,7 +432,7 @@ examples-build: $(EXAMPLE_BINS)
 
 # Only pkg-config output (plus an rpath to the stage) - no -Iinclude here.
 # -lm is the examples' own need (they call floor, ceil, ...), not libodhs's.
-build/examples/%: examples/%.c $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
+build/examples/%: examples/%.c examples/cli.h $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
 	@mkdir -p $(@D)
 	$(CC) $(CONSUMER_CFLAGS) -o $@ $< \
 	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) -lm $(STAGE_RPATH)

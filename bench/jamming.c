@@ -59,30 +59,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/utsname.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "bench.h"
 #include "odhs.h"
 
 #define N_SEEDS 20
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double cpu_seconds(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
-           1e-6 * (double)ru.ru_stime.tv_usec;
-}
 
 /* ---- one packing ---------------------------------------------------------- */
 typedef struct {
@@ -127,7 +112,7 @@ static int certified(const odhs_jam_certificate *c, int dim)
 #define SOFT_DPHI_END 1e-9
 static void run_soft(result *r)
 {
-    double t0 = now(), c0 = cpu_seconds();
+    double t0 = bench_wall(), c0 = bench_cpu();
     odhs_system *sys = NULL;
     odhs_softcore *sc = NULL;
     int d = r->dim;
@@ -172,8 +157,8 @@ static void run_soft(result *r)
     r->s_phi_lo = phi;
     r->cert.phi = phi;
     r->certified = 0;
-    r->wall = now() - t0;
-    r->cpu = cpu_seconds() - c0;
+    r->wall = bench_wall() - t0;
+    r->cpu = bench_cpu() - c0;
     r->done = 1;
     odhs_softcore_destroy(sc);
     odhs_system_destroy(sys);
@@ -187,7 +172,7 @@ static void run_packing(result *r, int f0_check)
         run_soft(r);
         return;
     }
-    double t0 = now(), c0 = cpu_seconds();
+    double t0 = bench_wall(), c0 = bench_cpu();
     odhs_system *sys = NULL;
     odhs_solver *sol = NULL;
     odhs_driver *drv = NULL;
@@ -202,8 +187,8 @@ static void run_packing(result *r, int f0_check)
     if (!r->rc) r->rc = odhs_stepper_create(sys, drv, sol, &st);
     if (!r->rc) r->rc = odhs_stepper_set_correction_interval(st, correction);
     if (!r->rc) r->rc = odhs_stepper_run_until_packing_fraction(st, 0.999);
-    r->wall = now() - t0;
-    r->cpu = cpu_seconds() - c0;
+    r->wall = bench_wall() - t0;
+    r->cpu = bench_cpu() - c0;
     if (st) {
         odhs_stepper_counts(st, &r->steps, &r->collisions, &r->openings);
         r->cert.size = sizeof r->cert;
@@ -253,7 +238,7 @@ static void run_pool(result *jobs, size_t njobs, int workers, double stop_at, do
     size_t next = 0;
     int running = 0;
     for (;;) {
-        while (running < workers && next < njobs && now() < stop_at) {
+        while (running < workers && next < njobs && bench_wall() < stop_at) {
             int w = 0;
             while (ch[w].pid != -1) w++;
             int p[2];
@@ -278,7 +263,7 @@ static void run_pool(result *jobs, size_t njobs, int workers, double stop_at, do
             ch[w].pid = pid;
             ch[w].fd = p[0];
             ch[w].job = next++;
-            ch[w].start = now();
+            ch[w].start = bench_wall();
             running++;
         }
         if (running == 0) break;
@@ -288,10 +273,10 @@ static void run_pool(result *jobs, size_t njobs, int workers, double stop_at, do
             if (ch[w].pid == -1) continue;
             int status;
             pid_t g = waitpid(ch[w].pid, &status, WNOHANG);
-            if (g == 0 && now() - ch[w].start > job_limit) {
+            if (g == 0 && bench_wall() - ch[w].start > job_limit) {
                 kill(ch[w].pid, SIGKILL);
                 waitpid(ch[w].pid, &status, 0);
-                jobs[ch[w].job].wall = now() - ch[w].start;
+                jobs[ch[w].job].wall = bench_wall() - ch[w].start;
                 jobs[ch[w].job].done = 0;
                 fprintf(stderr, "  killed: %dD N = %zu seed %u after %.0f s (time limit)\n", jobs[ch[w].job].dim,
                         jobs[ch[w].job].n, jobs[ch[w].job].seed, jobs[ch[w].job].wall);
@@ -304,7 +289,7 @@ static void run_pool(result *jobs, size_t njobs, int workers, double stop_at, do
                             r.rc, r.cert.phi, r.certified ? "certified" : "NOT certified", r.wall);
                 } else {
                     jobs[ch[w].job].done = 0;
-                    jobs[ch[w].job].wall = now() - ch[w].start;
+                    jobs[ch[w].job].wall = bench_wall() - ch[w].start;
                     fprintf(stderr, "  crashed: %dD N = %zu seed %u\n", jobs[ch[w].job].dim, jobs[ch[w].job].n,
                             jobs[ch[w].job].seed);
                 }
@@ -325,21 +310,8 @@ static FILE *csv;
 static void machine(int workers, double budget)
 {
     struct utsname u;
-    char model[256] = "unknown";
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (f) {
-        char line[512];
-        while (fgets(line, sizeof line, f))
-            if (!strncmp(line, "model name", 10)) {
-                char *c = strchr(line, ':');
-                if (c) {
-                    snprintf(model, sizeof model, "%s", c + 2);
-                    model[strcspn(model, "\n")] = 0;
-                }
-                break;
-            }
-        fclose(f);
-    }
+    char model[256];
+    bench_cpu_model(model, sizeof model);
     uname(&u);
     const char *ob = getenv("OPENBLAS_NUM_THREADS");
     printf("# bench/jamming: jammed packings by event-driven compression\n");
@@ -454,7 +426,7 @@ static double estimate(double t0, size_t n0, size_t n, int dense)
 
 int main(int argc, char **argv)
 {
-    double t_start = now();
+    double t_start = bench_wall();
     const char *b = getenv("ODHS_BENCH_BUDGET"), *j = getenv("ODHS_BENCH_JOBS"), *fs = getenv("ODHS_BENCH_SOLVER");
     double budget = b ? atof(b) : 1200.0;
     if (!(budget > 0)) budget = 1200.0;
@@ -572,9 +544,9 @@ int main(int argc, char **argv)
         printf("\n## Table 1: skipped (ODHS_BENCH_TABLES)\n");
     } else {
         fprintf(stderr, "phi_J statistics: 2D N = %zu, %d seeds\n", n2, N_SEEDS);
-        run_pool(st2, N_SEEDS, workers, now() + share, limit2, 0);
+        run_pool(st2, N_SEEDS, workers, bench_wall() + share, limit2, 0);
         fprintf(stderr, "phi_J statistics: 3D N = %zu, %d seeds\n", n3, N_SEEDS);
-        run_pool(st3, N_SEEDS, workers, now() + share, limit3, 0);
+        run_pool(st3, N_SEEDS, workers, bench_wall() + share, limit3, 0);
         summary s2 = summarize(st2, N_SEEDS), s3 = summarize(st3, N_SEEDS);
 
         printf("\n## Table 1: phi_J by compression (statistics over the runs that ended jammed)\n");
@@ -639,7 +611,7 @@ int main(int argc, char **argv)
         tr[k].wall = 0.0;
         tr[k].seed = 1;
         double est = sizes[k].dim == 2 ? estimate(t2, 128, sizes[k].n, dense) : estimate(t3, 64, sizes[k].n, dense);
-        double left = budget - (now() - t_start);
+        double left = budget - (bench_wall() - t_start);
         /* a statistics run at this size already measured it: reuse seed 1 */
         const result *reuse = NULL;
         if (sizes[k].dim == 2 && sizes[k].n == n2 && st2[0].wall >= 0) reuse = &st2[0];
@@ -758,6 +730,6 @@ int main(int argc, char **argv)
         }
     }
     if (csv) fclose(csv);
-    printf("\n# total %.0f s\n", now() - t_start);
+    printf("\n# total %.0f s\n", bench_wall() - t_start);
     return 0;
 }

@@ -23,7 +23,6 @@
  * usage: nearjam [SVG] [CSV]     (default nearjam.svg: residual against
  *        phi_J - phi for each backend)
  */
-#define _DEFAULT_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdint.h>
@@ -33,6 +32,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench.h"
 #include "odhs.h"
 #include "plot.h"
 
@@ -44,31 +44,6 @@ typedef struct {
     size_t nc, *ci, *cj;
     double phi;
 } snap;
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static void cpu_model(char *buf, size_t len)
-{
-    snprintf(buf, len, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f) return;
-    char line[512];
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                snprintf(buf, len, "%s", c + 2);
-                buf[strcspn(buf, "\n")] = 0;
-            }
-            break;
-        }
-    fclose(f);
-}
 
 static void snap_free(snap *s)
 {
@@ -97,9 +72,9 @@ int main(int argc, char **argv)
     const char *svg = argc > 1 ? argv[1] : "nearjam.svg";
     FILE *csv = argc > 2 ? fopen(argv[2], "w") : NULL;
     char cpu[256];
-    cpu_model(cpu, sizeof cpu);
-    double la[3] = {0, 0, 0};
-    getloadavg(la, 3);
+    bench_cpu_model(cpu, sizeof cpu);
+    double la[3];
+    bench_loadavg(la);
     printf("# near-jamming force solves; machine: %s; libodhs %s; load %.2f %.2f %.2f\n", cpu,
            odhs_version_string(), la[0], la[1], la[2]);
     printf("# b: simple-shear right-hand side; one solve per fresh handle (setup included); err = |f - f_spqr| / "
@@ -134,7 +109,7 @@ int main(int argc, char **argv)
         /* first approach (dt 1e-3): a snapshot after every step */
         snap *ring = calloc(NSNAP, sizeof *ring), *fine = calloc(NFINE, sizeof *fine);
         size_t nsnap = 0, nfine = 0;
-        double t0 = cpu_now();
+        double t0 = bench_cpu();
         int rc = odhs_stepper_run_until_packing_fraction(st, sc[q].dim == 2 ? 0.76 : 0.56);
         while (rc == ODHS_OK) {
             rc = odhs_stepper_step(st, NULL);
@@ -175,7 +150,7 @@ int main(int argc, char **argv)
             odhs_solver_destroy(so2);
             odhs_system_destroy(s2);
         }
-        double tj = cpu_now() - t0;
+        double tj = bench_cpu() - t0;
         if (rc != ODHS_JAMMED) {
             printf("%3d %5zu  compression stopped without jamming: %s\n", sc[q].dim, sc[q].n, odhs_stepper_errmsg(st));
         } else {
@@ -216,9 +191,9 @@ int main(int argc, char **argv)
                 int cr = odhs_solver_create_by_name(names[k], &s);
                 if (cr == ODHS_E_NOTINSTALLED) continue;
                 memset(x, 0, nc * sizeof *x);
-                double c0 = cpu_now();
+                double c0 = bench_cpu();
                 int sr = odhs_solver_solve(s, net, b, x);
-                double ms = 1e3 * (cpu_now() - c0);
+                double ms = 1e3 * (bench_cpu() - c0);
                 double res = NAN, bw = NAN, e = 0.0;
                 odhs_solver_get_stat(s, "residual", &res);
                 odhs_solver_get_stat(s, "backward_error", &bw);

@@ -43,6 +43,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench.h"
 #include "odhs.h"
 #include "plot.h"
 
@@ -58,38 +59,6 @@ typedef struct {
     char backend[32];
     int tiled;
 } result;
-
-static double wall_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static void cpu_model(char *buf, size_t len)
-{
-    snprintf(buf, len, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f) return;
-    char line[512];
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                snprintf(buf, len, "%s", c + 2);
-                buf[strcspn(buf, "\n")] = 0;
-            }
-            break;
-        }
-    fclose(f);
-}
 
 /* compressed packing of n discs at phi 0.80 */
 static int compress(size_t n, odhs_system **out)
@@ -167,7 +136,7 @@ static void measure(size_t n, double K, size_t paper_nmax, result *res)
     memset(res, 0, sizeof *res);
     res->n = n;
     res->window = K / (double)n;
-    double t0 = wall_now();
+    double t0 = bench_wall();
     odhs_system *start = NULL;
     int rc;
     if (n == 10000 && getenv("ODHS_SCALING_TILE") && atoi(getenv("ODHS_SCALING_TILE")) > 0) {
@@ -200,7 +169,7 @@ static void measure(size_t n, double K, size_t paper_nmax, result *res)
         odhs_solver_destroy(sol);
     }
     odhs_system_packing_fraction(start, &res->phi);
-    res->build_s = wall_now() - t0;
+    res->build_s = bench_wall() - t0;
     for (int s = 0; s < S_COUNT; ++s) {
         if (rc || (s == S_PAPER && n > paper_nmax)) {
             res->rc[s] = rc ? rc : 1;
@@ -211,11 +180,11 @@ static void measure(size_t n, double K, size_t paper_nmax, result *res)
         odhs_solver *sol;
         odhs_driver *drv;
         odhs_stepper *st = shear_stepper(sys, s, &sol, &drv);
-        double w0 = wall_now(), c0 = cpu_now();
+        double w0 = bench_wall(), c0 = bench_cpu();
         res->rc[s] = odhs_stepper_reset(st);
         if (!res->rc[s]) res->rc[s] = odhs_stepper_run_until_strain(st, res->window);
-        res->cpu[s] = cpu_now() - c0;
-        res->wall[s] = wall_now() - w0;
+        res->cpu[s] = bench_cpu() - c0;
+        res->wall[s] = bench_wall() - w0;
         if (res->rc[s]) fprintf(stderr, "scaling: N=%zu %s failed: %s\n", n, sname[s], odhs_stepper_errmsg(st));
         uint64_t co = 0, op = 0;
         odhs_stepper_counts(st, &res->steps[s], &co, &op);
@@ -330,7 +299,7 @@ static int replot(int argc, char **argv)
             all[j - 1] = t;
         }
     char cpu[256];
-    cpu_model(cpu, sizeof cpu);
+    bench_cpu_model(cpu, sizeof cpu);
     plot_and_fit(all, nn, all[0].window * (double)all[0].n, NAN, cpu, argv[2]);
     return 0;
 }
@@ -349,9 +318,9 @@ int main(int argc, char **argv)
     FILE *csv = argc > 4 && argv[4][0] ? fopen(argv[4], "w") : NULL;
     size_t paper_nmax = argc > 5 ? (size_t)atol(argv[5]) : 10000;
     char cpu[256];
-    cpu_model(cpu, sizeof cpu);
-    double la[3] = {0, 0, 0};
-    getloadavg(la, 3);
+    bench_cpu_model(cpu, sizeof cpu);
+    double la[3];
+    bench_loadavg(la);
     printf("# benchmark 4: cost per unit strain against N, 2D bidisperse, phi = 0.80, shear rate 1\n");
     printf("# machine: %s (%ld logical CPUs); libodhs %s; load average at the start %.2f %.2f %.2f\n", cpu,
            sysconf(_SC_NPROCESSORS_ONLN), odhs_version_string(), la[0], la[1], la[2]);

@@ -18,33 +18,14 @@
 #include <sys/utsname.h>
 #include <time.h>
 
+#include "bench.h"
 #include "odhs.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 static void machine(void)
 {
     struct utsname u;
-    char model[256] = "unknown";
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (f) {
-        char line[512];
-        while (fgets(line, sizeof line, f))
-            if (!strncmp(line, "model name", 10)) {
-                char *c = strchr(line, ':');
-                if (c) {
-                    snprintf(model, sizeof model, "%s", c + 2);
-                    model[strcspn(model, "\n")] = 0;
-                }
-                break;
-            }
-        fclose(f);
-    }
+    char model[256];
+    bench_cpu_model(model, sizeof model);
     uname(&u);
     printf("# machine: %s, %s %s, libodhs %s\n", model, u.sysname, u.machine, odhs_version_string());
 }
@@ -102,9 +83,9 @@ int main(int argc, char **argv)
             odhs_driver_create(&drv);
             odhs_driver_set_shear_rate(drv, 1.0);
             odhs_stepper_create(sys, drv, sol, &st);
-            double t0 = now();
+            double t0 = bench_wall();
             int rc = odhs_stepper_run_until_strain(st, gamma);
-            double t = now() - t0;
+            double t = bench_wall() - t0;
             uint64_t steps, nc, no;
             odhs_stepper_counts(st, &steps, &nc, &no);
             if (s == 0) tcg = t;

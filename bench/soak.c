@@ -30,6 +30,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
 #include "odhs.h"
 
 #define TOL_OVERLAP 1e-9
@@ -37,31 +38,6 @@
 #define TOL_NEGF 1e-9
 #define TOL_POWER 1e-8
 #define NSLICE 10
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static void cpu_model(char *buf, size_t len)
-{
-    snprintf(buf, len, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f) return;
-    char line[512];
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                snprintf(buf, len, "%s", c + 2);
-                buf[strcspn(buf, "\n")] = 0;
-            }
-            break;
-        }
-    fclose(f);
-}
 
 #define OK(call)                                                                                 \
     do {                                                                                         \
@@ -109,7 +85,7 @@ int main(int argc, char **argv)
         return 2;
     }
     char cpu[256];
-    cpu_model(cpu, sizeof cpu);
+    bench_cpu_model(cpu, sizeof cpu);
     printf("# soak: %s, libodhs %s\n", cpu, odhs_version_string());
     printf("# 2D bidisperse N=%zu phi=%.4f, shear gdot=1, Euler dt=1e-3, correction every 10 steps, solver %s\n", n,
            phi, solver);
@@ -142,7 +118,7 @@ int main(int argc, char **argv)
     double *f = NULL;
     size_t fcap = 0;
     uint64_t steps = 0;
-    double t_start = now();
+    double t_start = bench_wall();
     int cur = 0;
     sl[0].t0 = t_start;
     nevents = 0;
@@ -157,7 +133,7 @@ int main(int argc, char **argv)
         int k = (int)((double)nevents * NSLICE / (double)target);
         if (k >= NSLICE) k = NSLICE - 1;
         if (k != cur) {
-            sl[cur].t1 = now();
+            sl[cur].t1 = bench_wall();
             sl[k].t0 = sl[cur].t1;
             cur = k;
         }
@@ -211,7 +187,7 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    double t_end = now();
+    double t_end = bench_wall();
     sl[cur].t1 = t_end;
     /* events per slice from the event counter is not kept per slice: the
      * slice boundaries are event counts, so each slice holds target/NSLICE */

@@ -40,6 +40,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
 #include "odhs.h"
 
 #define N 100
@@ -53,31 +54,6 @@
             exit(1);                                                                           \
         }                                                                                      \
     } while (0)
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static void cpu_model(char *buf, size_t len)
-{
-    snprintf(buf, len, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f) return;
-    char line[512];
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                snprintf(buf, len, "%s", c + 2);
-                buf[strcspn(buf, "\n")] = 0;
-            }
-            break;
-        }
-    fclose(f);
-}
 
 /* ---- a tiny SVG line plot ------------------------------------------------------ */
 typedef struct {
@@ -224,7 +200,7 @@ static double run_ed(const odhs_system *start, double G, int integ, double dt, d
         C(odhs_stepper_set_tolerance(st, tol));
         C(odhs_stepper_set_correction_interval(st, 1));
     }
-    double t = now();
+    double t = bench_wall();
     for (int k = 1; k <= NS; ++k) {
         C(odhs_stepper_run_until_strain(st, G * k / NS));
         double sig[4];
@@ -232,7 +208,7 @@ static double run_ed(const odhs_system *start, double G, int integ, double dt, d
         S[k - 1] = sig[1];
         C(odhs_system_get_positions(sys, X + (size_t)(k - 1) * 2 * N));
     }
-    t = now() - t;
+    t = bench_wall() - t;
     uint64_t nc, no;
     odhs_stepper_counts(st, NULL, &nc, &no);
     if (events) *events = nc + no;
@@ -255,7 +231,7 @@ static double run_soft(const odhs_system *start, double G, int model, int qs, in
     C(odhs_softcore_set_minimiser(sc, minimiser));
     C(odhs_softcore_set_min_tolerance(sc, 1e-9, 1000000000u));
     if (!qs) C(odhs_softcore_set_shear_rate(sc, rate));
-    double t = now(), done = 0.0;
+    double t = bench_wall(), done = 0.0;
     for (int k = 1; k <= NS; ++k) {
         double target = G * k / NS, sig[4];
         if (qs) {
@@ -277,7 +253,7 @@ static double run_soft(const odhs_system *start, double G, int model, int qs, in
         }
         C(odhs_system_get_positions(sys, X + (size_t)(k - 1) * 2 * N));
     }
-    t = now() - t;
+    t = bench_wall() - t;
     uint64_t steps, fe, mi;
     odhs_softcore_counts(sc, &steps, &fe, &mi);
     if (work) *work = fe;
@@ -329,7 +305,7 @@ static double viscosity(const odhs_system *start, int model, double rate, double
     C(odhs_softcore_create(sys, &sc));
     C(odhs_softcore_set_model(sc, model));
     C(odhs_softcore_set_shear_rate(sc, rate));
-    double t = now(), sum = 0.0;
+    double t = bench_wall(), sum = 0.0;
     int cnt = 0;
     const int K = 60;
     for (int k = 1; k <= K; ++k) {
@@ -341,7 +317,7 @@ static double viscosity(const odhs_system *start, int model, double rate, double
             cnt++;
         }
     }
-    if (secs) *secs = now() - t;
+    if (secs) *secs = bench_wall() - t;
     odhs_softcore_destroy(sc);
     odhs_system_destroy(sys);
     return sum / cnt / rate;
@@ -369,9 +345,9 @@ static void inertial_paths(const odhs_system *start)
             if (m == 0) C(odhs_system_get_positions(sys, Xa));
             C(odhs_softcore_set_minimiser(sc, mins[m]));
             C(odhs_softcore_set_min_tolerance(sc, 1e-9, 1000000000u));
-            double t0 = now();
+            double t0 = bench_wall();
             C(odhs_softcore_minimise(sc, NULL));
-            t[m] = now() - t0;
+            t[m] = bench_wall() - t0;
             C(odhs_system_get_positions(sys, X[m]));
             odhs_softcore_destroy(sc);
             odhs_system_destroy(sys);
@@ -401,7 +377,7 @@ int main(int argc, char **argv)
     double GA = argc > 1 ? atof(argv[1]) : 0.002, GB = argc > 2 ? atof(argv[2]) : 0.005;
     const char *outdir = argc > 3 ? argv[3] : "docs/results";
     char cpu[256], path[512];
-    cpu_model(cpu, sizeof cpu);
+    bench_cpu_model(cpu, sizeof cpu);
     setvbuf(stdout, NULL, _IONBF, 0);
     printf("# bench/softcore  machine: %s (2 cores shared with other jobs: timings under load)\n", cpu);
     printf("# N = %d 2D bidisperse 1:1.4, phi = 0.82, k_e = k_d = 1 (tau_e = 1), GA = %g, GB = %g\n", N, GA, GB);

@@ -67,6 +67,7 @@
 #include <sys/utsname.h>
 #include <time.h>
 
+#include "bench.h"
 #include "odhs.h"
 #include "plot.h"
 
@@ -87,46 +88,16 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_spqr;
 
 /* ---- utilities ------------------------------------------------------------ */
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-/* CPU time of the process: the measurements (the machine may be shared) */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 static double t_start, budget = 540.0;
 static FILE *csv;
 
-static int over_budget(void) { return now() - t_start > budget; }
+static int over_budget(void) { return bench_wall() - t_start > budget; }
 
 static void machine(void)
 {
     struct utsname u;
-    char model[256] = "unknown";
-    int ncpu = 0;
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (f) {
-        char line[512];
-        while (fgets(line, sizeof line, f)) {
-            if (!strncmp(line, "model name", 10) && !strcmp(model, "unknown")) {
-                char *c = strchr(line, ':');
-                if (c) {
-                    snprintf(model, sizeof model, "%s", c + 2);
-                    model[strcspn(model, "\n")] = 0;
-                }
-            }
-            if (!strncmp(line, "processor", 9)) ncpu++;
-        }
-        fclose(f);
-    }
+    char model[256];
+    int ncpu = bench_cpu_model(model, sizeof model);
     uname(&u);
     const char *obt = getenv("OPENBLAS_NUM_THREADS");
     printf("# machine: %s (%d logical CPUs), %s %s %s\n", model, ncpu, u.sysname, u.release, u.machine);
@@ -248,18 +219,18 @@ static int tw_setup(void *state, const odhs_network *net)
 {
     tw_state *s = state;
     if (!s->inner->setup) return ODHS_OK;
-    double t0 = cpu_now();
+    double t0 = bench_cpu();
     int st = s->inner->setup(s->st, net);
-    s->t += cpu_now() - t0;
+    s->t += bench_cpu() - t0;
     return st;
 }
 
 static int tw_solve(void *state, const odhs_network *net, const double *b, double *x)
 {
     tw_state *s = state;
-    double t0 = cpu_now();
+    double t0 = bench_cpu();
     int st = s->inner->solve(s->st, net, b, x);
-    s->t += cpu_now() - t0;
+    s->t += bench_cpu() - t0;
     s->ncsum += (double)odhs_network_count(net);
     s->ncalls += 1.0;
     /* residual outside the timed region */
@@ -424,7 +395,7 @@ static int compress_scene(int dim, size_t n, double phi, uint64_t seed, scene *o
     if (!rc) rc = odhs_driver_create(&drv);
     if (!rc) rc = odhs_driver_set_compression_rate(drv, 1.0);
     if (!rc) rc = odhs_stepper_create(sys, drv, sol, &st);
-    double t0 = now();
+    double t0 = bench_wall();
     if (!rc) rc = odhs_stepper_run_until_packing_fraction(st, phi);
     if (!rc) rc = odhs_stepper_correct(st);
     if (!rc) {
@@ -437,7 +408,7 @@ static int compress_scene(int dim, size_t n, double phi, uint64_t seed, scene *o
     }
     uint64_t steps = 0, co = 0, op = 0;
     if (st) odhs_stepper_counts(st, &steps, &co, &op);
-    snprintf(out->note, sizeof out->note, "compressed in %.1f s (%s, %llu events)", now() - t0, cname,
+    snprintf(out->note, sizeof out->note, "compressed in %.1f s (%s, %llu events)", bench_wall() - t0, cname,
              (unsigned long long)(co + op));
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
@@ -607,14 +578,14 @@ static void measure_static(const scene *s, const char *solver, const char *mode,
             if (rc) break;
         }
         memset(x, 0, nc * sizeof *x);
-        double t0 = cpu_now();
+        double t0 = bench_cpu();
         if (fresh) {
             rc = odhs_solver_create(type, &sol);
             if (!rc) rc = odhs_solver_solve(sol, net, b, x);
         } else {
             rc = odhs_solver_solve(sol, net, b, x);
         }
-        tsum += cpu_now() - t0;
+        tsum += bench_cpu() - t0;
         double v = 0.0;
         odhs_solver_get_stat(sol, "residual", &v);
         res = fmax(res, v);
@@ -695,7 +666,7 @@ static void measure_stepper(const odhs_system *base, const char *solver, row *r)
 
 int main(int argc, char **argv)
 {
-    t_start = now();
+    t_start = bench_wall();
     const char *bs = getenv("ODHS_BENCH_BUDGET");
     if (bs && atof(bs) > 0) budget = atof(bs);
     if (argc > 1 && argv[1][0]) {
@@ -712,12 +683,8 @@ int main(int argc, char **argv)
     printf("# cg: tol 1e-12 (cold: zero guess); cholmod: default settings (CHOLMOD picks simplicial or\n"
            "#   supernodal, default ordering); cholmod-pcg: tol 1e-12, refactor_every 50; dense: LAPACK dpotrf\n"
            "#   (Nc <= 3000 fresh, Nc <= 1000 stepper); the library's iterative refinement (3 steps) is on\n");
-    double la[3] = {0, 0, 0};
-    FILE *lf = fopen("/proc/loadavg", "r");
-    if (lf) {
-        if (fscanf(lf, "%lf %lf %lf", &la[0], &la[1], &la[2]) != 3) la[0] = la[1] = la[2] = 0.0;
-        fclose(lf);
-    }
+    double la[3];
+    bench_loadavg(la);
     printf("# load average at the start: %.2f %.2f %.2f (other processes on the machine skew timings)\n", la[0], la[1],
            la[2]);
     printf("# budget %.0f s; static modes up to %d reps / %.1f s, stepper up to %d steps / %.1f s solver time\n",
@@ -798,12 +765,8 @@ int main(int argc, char **argv)
         }
         scene_free(&s);
     }
-    lf = fopen("/proc/loadavg", "r");
-    if (lf) {
-        if (fscanf(lf, "%lf %lf %lf", &la[0], &la[1], &la[2]) != 3) la[0] = la[1] = la[2] = 0.0;
-        fclose(lf);
-    }
-    printf("# total wall time %.1f s; load average at the end: %.2f %.2f %.2f\n", now() - t_start, la[0], la[1], la[2]);
+    bench_loadavg(la);
+    printf("# total wall time %.1f s; load average at the end: %.2f %.2f %.2f\n", bench_wall() - t_start, la[0], la[1], la[2]);
     /* plots: ms per solve against N, one file per dimension */
     const char *prefix = argc > 2 ? argv[2] : "solvers";
     const char *pnames[] = {"cg", "cholmod", "cholmod-pcg", "auto", "dense", "spqr"};

@@ -24,7 +24,6 @@
  * environment: ODHS_TRADE_PAPER_1E7=1 adds paper mode at dt 1e-7 (~10 CPU
  *        minutes at N = 1000)
  */
-#define _DEFAULT_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -32,42 +31,11 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
 #include "odhs.h"
 #include "plot.h"
 
 #define NSAMP 20
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static void cpu_model(char *buf, size_t len)
-{
-    snprintf(buf, len, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f) return;
-    char line[512];
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                snprintf(buf, len, "%s", c + 2);
-                buf[strcspn(buf, "\n")] = 0;
-            }
-            break;
-        }
-    fclose(f);
-}
 
 typedef struct {
     const char *label;
@@ -105,7 +73,7 @@ static int run(const odhs_system *start, const char *solver, const setting *s, d
     }
     r->gap = 0.0;
     r->rc = 0;
-    double t0 = now(), c0 = cpu_now();
+    double t0 = bench_wall(), c0 = bench_cpu();
     r->rc = odhs_stepper_reset(st);
     for (int k = 0; k <= NSAMP && !r->rc; ++k) {
         if (k) r->rc = odhs_stepper_run_until_strain(st, gamma * k / NSAMP);
@@ -114,8 +82,8 @@ static int run(const odhs_system *start, const char *solver, const setting *s, d
         r->gap = fmax(r->gap, g);
         odhs_stepper_shear_stress(st, &r->stress[k]);
     }
-    r->seconds = now() - t0;
-    r->cpu = cpu_now() - c0;
+    r->seconds = bench_wall() - t0;
+    r->cpu = bench_cpu() - c0;
     uint64_t nc, no;
     odhs_stepper_counts(st, &r->steps, &nc, &no);
     odhs_stepper_adaptive_stats(st, &r->rejected, NULL);
@@ -209,7 +177,7 @@ static int replot(int argc, char **argv)
     size_t n = argc > 4 ? (size_t)atol(argv[4]) : 1000;
     double gamma = argc > 5 ? atof(argv[5]) : 0.01;
     char model[256], note[400];
-    cpu_model(model, sizeof model);
+    bench_cpu_model(model, sizeof model);
     snprintf(note, sizeof note, "%.120s; replotted from %.200s (times: see the run's output)", model, argv[2]);
     trade_plot(argv[3], n, gamma, argc > 6 ? argv[6] : "auto", lp, cpu, rms, m, note);
     return 0;
@@ -224,7 +192,7 @@ int main(int argc, char **argv)
     FILE *csv = argc > 4 && argv[4][0] ? fopen(argv[4], "w") : NULL;
     const char *svg = argc > 5 ? argv[5] : "trade.svg";
     char cpu[256];
-    cpu_model(cpu, sizeof cpu);
+    bench_cpu_model(cpu, sizeof cpu);
 
     odhs_system *sys;
     odhs_solver *cg;
@@ -246,8 +214,8 @@ int main(int argc, char **argv)
     odhs_driver_destroy(drv);
     odhs_solver_destroy(cg);
 
-    double la[3] = {0, 0, 0};
-    getloadavg(la, 3);
+    double la[3];
+    bench_loadavg(la);
     printf("# machine: %s; libodhs %s; load average at the start %.2f %.2f %.2f (shared machine: ratios use CPU "
            "time)\n", cpu, odhs_version_string(), la[0], la[1], la[2]);
     printf("# N = %zu 2D bidisperse, phi = 0.80, shear to strain %g; paper settings: cg, others: %s\n", n,

@@ -1,12 +1,37 @@
-/* cli.h - small helpers shared by the example programs: number parsing and
- * the built-in scene (header-only, so each example stays one file to build:
- * cc example.c $(pkg-config --cflags --libs odhs) -lm). */
+/* cli.h - what the example programs share: the option table, its parser and
+ * its --help printer, the options several examples take, number parsing, the
+ * built-in scene and the checks of the files and solver named on the command
+ * line (header-only, so each example stays one file to build:
+ * cc example.c $(pkg-config --cflags --libs odhs) -lm).
+ *
+ * An example lists its options in a table ended by CLI_END, the common ones
+ * by the macros below so that they read the same in every --help:
+ *
+ *     const cli_opt opts[] = {
+ *         CLI_IN(&in),
+ *         CLI_OPT_DOUBLE("--strain", &strain, "X", "total strain", CLI_POSITIVE),
+ *         CLI_N(&n),
+ *         CLI_END,
+ *     };
+ *     const cli_spec cli = {"prog", NULL, opts, "footer lines\n", 0};
+ *     int rc = cli_parse(&cli, argc, argv);
+ *     if (rc != CLI_GO) return rc;
+ *
+ * The command-line contract every example keeps: --help (or -h) prints the
+ * usage to stdout and exits 0; an unknown option, a missing value or a bad
+ * value prints a message and the usage to stderr and exits 2; options are
+ * read in order, the last one wins; a value is the next argument, whatever
+ * it looks like. The usage shows each option's default as the variable holds
+ * it before the command line is read. */
 #ifndef ODHS_EXAMPLES_CLI_H
 #define ODHS_EXAMPLES_CLI_H
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <odhs.h>
 
@@ -32,6 +57,299 @@ static inline int cli_ulong(const char *s, unsigned long *out)
     return 0;
 }
 
+/* ---- the option table ------------------------------------------------------ */
+
+/* what an option's value is, and what cli_opt.value points to */
+enum {
+    CLI_INT,    /* int: a non-negative integer                              */
+    CLI_ULONG,  /* unsigned long: counts and seeds                          */
+    CLI_DOUBLE, /* double: a finite number                                  */
+    CLI_STRING, /* const char *: the argument itself (a file, a name)       */
+    CLI_FLAG,   /* int: set to 1, takes no value                            */
+    CLI_LIST    /* int: the index of the value in cli_opt.choices           */
+};
+
+/* cli_opt.bounds: which of lo < x, lo <= x, x < hi, x <= hi a number must meet */
+enum { CLI_GT = 1, CLI_GE = 2, CLI_LT = 4, CLI_LE = 8 };
+
+typedef struct {
+    const char *name;           /* "--dt"; NULL ends the table (CLI_END)        */
+    int kind;                   /* CLI_INT ... CLI_LIST                          */
+    void *value;                /* the variable, holding the default            */
+    const char *arg;            /* the value in the usage: "X", "FILE.xyz"      */
+    const char *help;           /* one sentence, wrapped by the printer         */
+    int bounds;                 /* CLI_GT | CLI_LE ...: the range of a number   */
+    double lo, hi;              /* its ends                                      */
+    const char *const *choices; /* CLI_LIST: the accepted values, NULL-ended    */
+    const char *deftext;        /* the default in words instead of the value
+                                 * (a string option: only while it is NULL);
+                                 * "": show no default                           */
+} cli_opt;
+
+typedef struct {
+    const char *prog;     /* in the usage line and in every message          */
+    const char *synopsis; /* after "usage: PROG "; NULL: "[options]"          */
+    const cli_opt *opts;  /* the table, ended by CLI_END                      */
+    const char *footer;   /* lines printed after the options; NULL: none      */
+    int mute;             /* print nothing (MPI ranks other than 0)           */
+} cli_spec;
+
+/* cli_parse: go on with the program (any other value is its exit status) */
+#define CLI_GO (-1)
+
+/* The ranges, as the last argument of CLI_OPT_*: */
+#define CLI_ANY .bounds = 0
+#define CLI_POSITIVE .bounds = CLI_GT, .lo = 0        /* x > 0       */
+#define CLI_NONNEGATIVE .bounds = CLI_GE, .lo = 0     /* x >= 0      */
+#define CLI_ABOVE(a) .bounds = CLI_GT, .lo = (a)      /* x > a       */
+#define CLI_ATLEAST(a) .bounds = CLI_GE, .lo = (a)    /* x >= a      */
+#define CLI_ATMOST(b) .bounds = CLI_LE, .hi = (b)     /* x <= b      */
+#define CLI_OPEN(a, b) .bounds = CLI_GT | CLI_LT, .lo = (a), .hi = (b)  /* a < x < b   */
+#define CLI_ABOVE_ATMOST(a, b) .bounds = CLI_GT | CLI_LE, .lo = (a), .hi = (b) /* a < x <= b  */
+#define CLI_BETWEEN(a, b) .bounds = CLI_GE | CLI_LE, .lo = (a), .hi = (b)    /* a <= x <= b */
+
+/* A table entry; the pointer must have the kind's type (checked by the
+ * compiler). The trailing arguments are designators: a range above, and
+ * .deftext = "..." where wanted. */
+#define CLI_PTR_(type, p) ((void *)(1 ? (p) : (type *)0))
+#define CLI_OPT_INT(name, p, arg, help, ...) {name, CLI_INT, CLI_PTR_(int, p), arg, help, __VA_ARGS__}
+#define CLI_OPT_ULONG(name, p, arg, help, ...) {name, CLI_ULONG, CLI_PTR_(unsigned long, p), arg, help, __VA_ARGS__}
+#define CLI_OPT_DOUBLE(name, p, arg, help, ...) {name, CLI_DOUBLE, CLI_PTR_(double, p), arg, help, __VA_ARGS__}
+#define CLI_OPT_STRING(name, p, arg, help, ...) {name, CLI_STRING, CLI_PTR_(const char *, p), arg, help, __VA_ARGS__}
+#define CLI_OPT_FLAG(name, p, help) {name, CLI_FLAG, CLI_PTR_(int, p), NULL, help, .bounds = 0}
+#define CLI_OPT_LIST(name, p, arg, help, list, ...)                                                                  \
+    {name, CLI_LIST, CLI_PTR_(int, p), arg, help, .choices = (list), __VA_ARGS__}
+#define CLI_END {.name = NULL}
+
+/* ---- the options several examples take ------------------------------------- */
+
+/* the integrators of the stepper, by index (--integrator) */
+static const char *const cli_integrators[] = {"euler", "heun", NULL};
+_Static_assert(ODHS_INTEGRATOR_EULER == 0 && ODHS_INTEGRATOR_HEUN == 1, "cli_integrators is indexed by the enum");
+
+#define CLI_SOLVER_HELP "linear solver: cg, dense, cholmod, cholmod-pcg, spqr"
+/* what cli_default_solver picks */
+#define CLI_SOLVER_AUTO "cholmod-pcg when built with SuiteSparse, else dense up to N = 2000 and cg above"
+
+#define CLI_IN(p)                                                                                                    \
+    CLI_OPT_STRING("--in", p, "FILE.xyz", "start from a configuration file (extended XYZ) instead of the built-in " \
+                   "scene", CLI_ANY)
+#define CLI_OUT(p) CLI_OPT_STRING("--out", p, "FILE.xyz", "write the final configuration (extended XYZ)", CLI_ANY)
+#define CLI_SVG(p)                                                                                                   \
+    CLI_OPT_STRING("--svg", p, "FILE.svg",                                                                           \
+                   "picture of the final state: discs coloured by size, contact forces as lines of width "           \
+                   "proportional to the force",                                                                      \
+                   CLI_ANY)
+/* columns: the CSV header line, also given to cli_series */
+#define CLI_SERIES(p, columns) CLI_OPT_STRING("--series", p, "FILE.csv", "write " columns " per output interval", CLI_ANY)
+#define CLI_SOLVER(p) CLI_OPT_STRING("--solver", p, "NAME", CLI_SOLVER_HELP, .deftext = CLI_SOLVER_AUTO)
+#define CLI_INTEGRATOR(p)                                                                                            \
+    CLI_OPT_LIST("--integrator", p, "NAME", "euler (the paper's fixed step --dt) or heun (adaptive, steps of at most " \
+                 "--dt)", cli_integrators, CLI_ANY)
+#define CLI_TOL(p) CLI_OPT_DOUBLE("--tol", p, "X", "heun: error per step relative to the mean diameter", CLI_OPEN(0, 1))
+/* unit: what --dt and --every are measured in */
+#define CLI_DT(p, unit) CLI_OPT_DOUBLE("--dt", p, "X", "step in " unit, CLI_POSITIVE)
+#define CLI_EVERY(p, unit) CLI_OPT_DOUBLE("--every", p, "X", "output interval in " unit, CLI_POSITIVE)
+#define CLI_STRAIN(p) CLI_OPT_DOUBLE("--strain", p, "X", "total shear strain", CLI_POSITIVE)
+#define CLI_TIME(p) CLI_OPT_DOUBLE("--time", p, "X", "run length in units of tau", CLI_POSITIVE)
+#define CLI_SEED(p) CLI_OPT_ULONG("--seed", p, "S", "random seed", CLI_ANY)
+/* the built-in scene (cli_scene): --n, --dim and --seed as three entries;
+ * --phi where the scene is built at a packing fraction of its own */
+#define CLI_N(p) CLI_OPT_ULONG("--n", p, "N", "built-in scene: number of particles", CLI_ATLEAST(2))
+#define CLI_DIM(p) CLI_OPT_INT("--dim", p, "D", "built-in scene: dimension 2 or 3", CLI_BETWEEN(2, 3))
+#define CLI_SCENE(n, dim, seed) CLI_N(n), CLI_DIM(dim), CLI_SEED(seed)
+#define CLI_PHI(p) CLI_OPT_DOUBLE("--phi", p, "X", "built-in scene: packing fraction", CLI_OPEN(0, 1))
+
+/* ---- parser and usage -------------------------------------------------------- */
+
+#define CLI_WIDTH 80    /* the usage is wrapped to this many columns */
+#define CLI_MAX_OPTS 48 /* the longest table whose defaults cli_parse remembers */
+
+/* x as %.15g, or as 1e-n for a power of ten that %g writes longer (1e-3,
+ * not 0.001; 1e-6, not 1e-06) */
+static inline void cli_format_double_(double x, char *buf, size_t len)
+{
+    char e[32];
+    snprintf(buf, len, "%.15g", x);
+    snprintf(e, sizeof e, "%.0e", x); /* 1e-03 */
+    if (strncmp(e, "1e-", 3) || strtod(e, NULL) != x) return;
+    const char *d = e + 3 + strspn(e + 3, "0");
+    size_t n = strlen(d);
+    if (n + 3 >= strlen(buf)) return;
+    memcpy(buf, "1e-", 3);
+    memcpy(buf + 3, d, n + 1);
+}
+
+/* the default of o as the usage shows it, or NULL for none (buf: room for a number) */
+static inline const char *cli_default_(const cli_opt *o, char *buf, size_t len)
+{
+    if (o->kind == CLI_STRING) {
+        const char *v = *(const char *const *)o->value;
+        return v ? v : o->deftext;
+    }
+    if (o->deftext) return o->deftext;
+    switch (o->kind) {
+    case CLI_INT: snprintf(buf, len, "%d", *(const int *)o->value); return buf;
+    case CLI_ULONG: snprintf(buf, len, "%lu", *(const unsigned long *)o->value); return buf;
+    case CLI_DOUBLE: cli_format_double_(*(const double *)o->value, buf, len); return buf;
+    case CLI_LIST: return o->choices[*(const int *)o->value];
+    default: return NULL;
+    }
+}
+
+/* text in words from column col, wrapped to CLI_WIDTH with continuation
+ * lines at column indent; whole: keep it on one line if a line can hold it.
+ * Returns the column reached. */
+static inline int cli_words_(FILE *f, int col, int indent, const char *text, int whole)
+{
+    int n = (int)strlen(text), first = col == indent;
+    if (whole && !first && col + 1 + n > CLI_WIDTH && indent + n <= CLI_WIDTH) {
+        fprintf(f, "\n%*s", indent, "");
+        col = indent;
+        first = 1;
+    }
+    for (const char *p = text; *p;) {
+        if (*p == ' ') {
+            ++p;
+            continue;
+        }
+        int w = (int)strcspn(p, " ");
+        if (!first && col + 1 + w > CLI_WIDTH) {
+            fprintf(f, "\n%*s", indent, "");
+            col = indent;
+            first = 1;
+        }
+        col += fprintf(f, "%s%.*s", first ? "" : " ", w, p);
+        first = 0;
+        p += w;
+    }
+    return col;
+}
+
+/* the usage; def[i]: the default of opts[i] (NULL: read the variables now) */
+static inline void cli_usage_defaults_(const cli_spec *s, FILE *f, const char *const *def)
+{
+    if (s->mute) return;
+    fprintf(f, "usage: %s %s\n", s->prog, s->synopsis ? s->synopsis : "[options]");
+    int width = 18; /* "--name ARG" column: the longest one and a space */
+    for (const cli_opt *o = s->opts; o->name; ++o) {
+        int w = (int)strlen(o->name) + (o->arg ? 1 + (int)strlen(o->arg) : 0) + 1;
+        if (w > width) width = w;
+    }
+    for (const cli_opt *o = s->opts; o->name; ++o) {
+        char head[96], text[512], buf[32];
+        snprintf(head, sizeof head, "%s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
+        int col = cli_words_(f, fprintf(f, "  %-*s ", width, head), width + 3, o->help, 0);
+        const char *d = def ? def[o - s->opts] : cli_default_(o, buf, sizeof buf);
+        if (d && *d) {
+            snprintf(text, sizeof text, "(default %s)", d);
+            cli_words_(f, col, width + 3, text, 1);
+        }
+        fputc('\n', f);
+    }
+    fprintf(f, "  %-*s this message\n", width, "--help");
+    if (s->footer) fputs(s->footer, f);
+}
+
+/* the defaults as the usage shows them, taken by cli_parse before it reads
+ * the command line (the values the variables hold later are not defaults) */
+typedef struct {
+    const cli_spec *spec; /* whose defaults these are */
+    const char *def[CLI_MAX_OPTS];
+    char buf[CLI_MAX_OPTS][32];
+} cli_defaults_;
+
+static inline cli_defaults_ *cli_saved_(void)
+{
+    static cli_defaults_ saved;
+    return &saved;
+}
+
+/* the usage, for a check made after cli_parse (a bad --solver ...) */
+static inline void cli_usage(const cli_spec *s, FILE *f)
+{
+    cli_defaults_ *d = cli_saved_();
+    cli_usage_defaults_(s, f, d->spec == s ? d->def : NULL);
+}
+
+static inline int cli_in_range_(const cli_opt *o, double x)
+{
+    return !((o->bounds & CLI_GT && !(x > o->lo)) || (o->bounds & CLI_GE && !(x >= o->lo)) ||
+             (o->bounds & CLI_LT && !(x < o->hi)) || (o->bounds & CLI_LE && !(x <= o->hi)));
+}
+
+/* store the value v of option o; 0 when v is not a value o takes */
+static inline int cli_set_(const cli_opt *o, const char *v)
+{
+    unsigned long u;
+    double x;
+    switch (o->kind) {
+    case CLI_INT:
+        if (cli_ulong(v, &u) || u > INT_MAX || !cli_in_range_(o, (double)u)) return 0;
+        *(int *)o->value = (int)u;
+        return 1;
+    case CLI_ULONG:
+        if (cli_ulong(v, &u) || !cli_in_range_(o, (double)u)) return 0;
+        *(unsigned long *)o->value = u;
+        return 1;
+    case CLI_DOUBLE:
+        if (cli_double(v, &x) || !cli_in_range_(o, x)) return 0;
+        *(double *)o->value = x;
+        return 1;
+    case CLI_STRING: *(const char **)o->value = v; return 1;
+    case CLI_LIST:
+        for (int k = 0; o->choices[k]; ++k)
+            if (!strcmp(v, o->choices[k])) {
+                *(int *)o->value = k;
+                return 1;
+            }
+        return 0;
+    default: return 0;
+    }
+}
+
+/* Read the command line into the table's variables. Returns CLI_GO, or the
+ * exit status: 0 after --help, 2 after a bad option (message and usage on
+ * stderr). */
+static inline int cli_parse(const cli_spec *s, int argc, char **argv)
+{
+    size_t n = 0;
+    while (s->opts[n].name) ++n;
+    cli_defaults_ *d = cli_saved_();
+    d->spec = n <= CLI_MAX_OPTS ? s : NULL;
+    for (size_t i = 0; d->spec && i < n; ++i) d->def[i] = cli_default_(&s->opts[i], d->buf[i], sizeof d->buf[i]);
+    for (int a = 1; a < argc; ++a) {
+        const char *o = argv[a];
+        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
+            cli_usage(s, stdout);
+            return 0;
+        }
+        const cli_opt *opt = s->opts;
+        while (opt->name && strcmp(opt->name, o)) ++opt;
+        if (opt->name && opt->kind == CLI_FLAG) {
+            *(int *)opt->value = 1;
+            continue;
+        }
+        int bad = 1;
+        if (a + 1 >= argc) {
+            if (!s->mute) fprintf(stderr, "%s: unknown option or missing value: %s\n", s->prog, o);
+        } else if (!opt->name) {
+            if (!s->mute) fprintf(stderr, "%s: unknown option %s\n", s->prog, o);
+        } else if (!cli_set_(opt, argv[++a])) {
+            if (!s->mute) fprintf(stderr, "%s: bad value for %s: %s\n", s->prog, o, argv[a]);
+        } else {
+            bad = 0;
+        }
+        if (bad) {
+            cli_usage(s, stderr);
+            return 2;
+        }
+    }
+    return CLI_GO;
+}
+
+/* ---- the scene, the solver and the files --------------------------------------- */
+
 /* The examples' built-in scene: 50:50 bidisperse radii 0.5/0.7 with 3%
  * polydispersity, placed at random at phi = 0.45 (2D) or 0.30 (3D), or at
  * phi_max if that is lower. Returns ODHS_OK or an error (the message is in
@@ -46,9 +364,9 @@ static inline int cli_scene(int dim, unsigned long n, unsigned long seed, double
     return odhs_system_place_random(*out, phi0, seed + 1);
 }
 
-/* The solver the examples use close to jamming: CHOLMOD as a preconditioner
- * for CG when the library has it, else dense Cholesky for small systems and
- * CG for large ones (CG alone stalls close to jamming). */
+/* The solver the examples use close to jamming (CLI_SOLVER_AUTO): CHOLMOD as
+ * a preconditioner for CG when the library has it, else dense Cholesky for
+ * small systems and CG for large ones (CG alone stalls close to jamming). */
 static inline const char *cli_default_solver(size_t n)
 {
     odhs_solver *s;
@@ -57,6 +375,50 @@ static inline const char *cli_default_solver(size_t n)
         return "cholmod-pcg";
     }
     return n <= 2000 ? "dense" : "cg";
+}
+
+/* the solver of that name; 0, or 2 (a bad --solver) with a message */
+static inline int cli_solver(const char *prog, const char *name, odhs_solver **out)
+{
+    int rc = odhs_solver_create_by_name(name, out);
+    if (!rc) return 0;
+    fprintf(stderr, "%s: solver %s: %s\n", prog, name, odhs_strerror(rc));
+    return 2;
+}
+
+/* the configuration in the file (--in); 0, or 1 (unreadable) with a message */
+static inline int cli_read_xyz(const char *prog, const char *path, odhs_system **out)
+{
+    char err[512];
+    if (!odhs_xyz_read(path, out, err, sizeof err)) return 0;
+    fprintf(stderr, "%s: cannot read %s: %s\n", prog, path, err);
+    return 1;
+}
+
+/* the configuration of --in when there is one, else the built-in scene
+ * (cli_scene; *out NULL on entry); 0, or 1 with a message */
+static inline int cli_start(const char *prog, const char *in, int dim, unsigned long n, unsigned long seed,
+                            double phi_max, odhs_system **out)
+{
+    if (in) return cli_read_xyz(prog, in, out);
+    int rc = cli_scene(dim, n, seed, phi_max, out);
+    if (!rc) return 0;
+    fprintf(stderr, "%s: building the scene: %s\n", prog, *out ? odhs_system_errmsg(*out) : odhs_strerror(rc));
+    return 1;
+}
+
+/* the --series file opened with its header line, or *out = NULL without a
+ * path; 0, or 1 (cannot write) with a message */
+static inline int cli_series(const char *prog, const char *path, const char *columns, FILE **out)
+{
+    *out = NULL;
+    if (!path) return 0;
+    if (!(*out = fopen(path, "w"))) {
+        fprintf(stderr, "%s: cannot write %s: %s\n", prog, path, strerror(errno));
+        return 1;
+    }
+    fprintf(*out, "%s\n", columns);
+    return 0;
 }
 
 #endif /* ODHS_EXAMPLES_CLI_H */

@@ -11,35 +11,16 @@
  * Build against an installed libodhs:
  *     cc composite.c $(pkg-config --cflags --libs odhs) -lm -o composite
  */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include <odhs.h>
 
 #include "cli.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: composite [options]\n"
-            "  --bodies N         number of composite particles (default 100)\n"
-            "  --beads K          beads per body: 2 (dimers) or 3 (trimers, default)\n"
-            "  --phi X            bead packing fraction to compress to (default 0.70)\n"
-            "  --strain X         shear strain after the compression (default 1)\n"
-            "  --every X          output interval in strain (default 0.05)\n"
-            "  --seed S           random seed (default 1)\n"
-            "  --solver NAME      linear solver (default cholmod-pcg if available, else dense/cg)\n"
-            "  --series FILE.csv  strain,shear_stress,pressure,z,events,bond_error per interval\n"
-            "  --svg FILE.svg     picture of the final state: beads coloured by size, bonds as\n"
-            "                     thin dark-blue lines, contact forces as black lines of width\n"
-            "                     proportional to the force\n"
-            "  --out FILE.xyz     final configuration (extended XYZ)\n"
-            "  --help             this message\n"
-            "Stresses in units of gammadot/xi0 (per length, 2D).\n");
-}
+/* the --series columns */
+#define SERIES "strain,shear_stress,pressure,z,events,bond_error"
 
 #define CHECK(call)                                                                             \
     do {                                                                                        \
@@ -108,50 +89,32 @@ int main(int argc, char **argv)
     const char *series = NULL, *svg = NULL, *outpath = NULL, *solver_name = NULL;
     double phi = 0.70, strain = 1.0, every = 0.05;
     unsigned long nb = 100, k = 3, seed = 1;
-    for (int a = 1; a < argc; ++a) {
-        const char *o = argv[a];
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            usage(stdout);
-            return 0;
-        }
-        if (a + 1 >= argc) {
-            fprintf(stderr, "composite: unknown option or missing value: %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        const char *v = argv[++a];
-        int bad = 0;
-        if (!strcmp(o, "--series")) series = v;
-        else if (!strcmp(o, "--svg")) svg = v;
-        else if (!strcmp(o, "--out")) outpath = v;
-        else if (!strcmp(o, "--solver")) solver_name = v;
-        else if (!strcmp(o, "--bodies")) bad = cli_ulong(v, &nb) || nb < 2;
-        else if (!strcmp(o, "--beads")) bad = cli_ulong(v, &k) || (k != 2 && k != 3);
-        else if (!strcmp(o, "--phi")) bad = cli_double(v, &phi) || phi <= 0 || phi >= 1;
-        else if (!strcmp(o, "--strain")) bad = cli_double(v, &strain) || strain <= 0;
-        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
-        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
-        else {
-            fprintf(stderr, "composite: unknown option %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        if (bad) {
-            fprintf(stderr, "composite: bad value for %s: %s\n", o, v);
-            usage(stderr);
-            return 2;
-        }
-    }
+    const cli_opt opts[] = {
+        CLI_OPT_ULONG("--bodies", &nb, "N", "number of composite particles", CLI_ATLEAST(2)),
+        CLI_OPT_ULONG("--beads", &k, "K", "beads per body: 2 (dimers) or 3 (trimers)", CLI_BETWEEN(2, 3)),
+        CLI_OPT_DOUBLE("--phi", &phi, "X", "bead packing fraction to compress to", CLI_OPEN(0, 1)),
+        CLI_STRAIN(&strain),
+        CLI_EVERY(&every, "strain"),
+        CLI_SEED(&seed),
+        CLI_SOLVER(&solver_name),
+        CLI_SERIES(&series, SERIES),
+        CLI_SVG(&svg),
+        CLI_OUT(&outpath),
+        CLI_END,
+    };
+    const cli_spec cli = {"composite", NULL, opts,
+                          "The shear starts after the compression. The picture (--svg) draws the bonds\n"
+                          "as thin dark-blue lines.\n"
+                          "Stresses in units of gammadot/xi0 (per length, 2D).\n",
+                          0};
+    int rc = cli_parse(&cli, argc, argv);
+    if (rc != CLI_GO) return rc;
     odhs_system *sys;
     if (build(nb, (int)k, seed, &sys)) return 1;
     size_t n = odhs_system_count(sys);
     if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
-    int rc = odhs_solver_create_by_name(solver_name, &solver);
-    if (rc) {
-        fprintf(stderr, "composite: solver %s: %s\n", solver_name, odhs_strerror(rc));
-        return 2;
-    }
+    if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
     odhs_driver *drv;
     odhs_stepper *st;
     CHECK(odhs_driver_create(&drv));
@@ -188,15 +151,8 @@ int main(int argc, char **argv)
     CHECK(odhs_driver_set_shear_rate(drv, 1.0));
     CHECK(odhs_stepper_correct(st));
 
-    FILE *csv = NULL;
-    if (series) {
-        csv = fopen(series, "w");
-        if (!csv) {
-            fprintf(stderr, "composite: cannot write %s: %s\n", series, strerror(errno));
-            return 1;
-        }
-        fprintf(csv, "strain,shear_stress,pressure,z,events,bond_error\n");
-    }
+    FILE *csv;
+    if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     printf("%10s %14s %14s %8s %10s %11s\n", "strain", "shear_stress", "pressure", "z", "events", "bond_error");
     double g0;
     CHECK(odhs_stepper_strain(st, &g0));

@@ -13,7 +13,6 @@
  * Build against an installed libodhs:
  *     cc hopper.c $(pkg-config --cflags --libs odhs) -lm -o hopper
  */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,25 +22,8 @@
 
 #include "cli.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: hopper [options]\n"
-            "  --n N              number of discs (default 300; radii 0.5 and 0.7 +-5%%)\n"
-            "  --outlet D         outlet width in small diameters (default 3.2)\n"
-            "  --width W          box width (default 24)\n"
-            "  --time T           longest run, in units of tau (default 400)\n"
-            "  --every X          output interval in tau (default 1)\n"
-            "  --seed S           random seed (default 1)\n"
-            "  --solver NAME      linear solver (default cholmod-pcg if available, else dense/cg)\n"
-            "  --series FILE.csv  time,discharged,mean_speed,z,events per interval\n"
-            "  --svg FILE.svg     picture of the final state (walls grey, arch dark red)\n"
-            "  --out FILE.xyz     final configuration\n"
-            "  --help             this message\n"
-            "Time in units of tau = lambda/(xi0 f_rms) (lambda the mean diameter, f_rms the\n"
-            "rms weight); the weight of a disc is proportional to its area.\n"
-            "Exit status 0 whether or not the outlet clogged (stdout says which).\n");
-}
+/* the --series columns */
+#define SERIES "time,discharged,mean_speed,z,events"
 
 #define CHECK(call)                                                                             \
     do {                                                                                        \
@@ -131,40 +113,28 @@ int main(int argc, char **argv)
     const char *series = NULL, *svg = NULL, *outpath = NULL, *solver_name = NULL;
     double outlet = 3.2, width = 24.0, tmax = 400.0, every = 1.0;
     unsigned long n = 300, seed = 1;
-    for (int a = 1; a < argc; ++a) {
-        const char *o = argv[a];
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            usage(stdout);
-            return 0;
-        }
-        if (a + 1 >= argc) {
-            fprintf(stderr, "hopper: unknown option or missing value: %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        const char *v = argv[++a];
-        int bad = 0;
-        if (!strcmp(o, "--series")) series = v;
-        else if (!strcmp(o, "--svg")) svg = v;
-        else if (!strcmp(o, "--out")) outpath = v;
-        else if (!strcmp(o, "--solver")) solver_name = v;
-        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 1;
-        else if (!strcmp(o, "--outlet")) bad = cli_double(v, &outlet) || outlet <= 1.0;
-        else if (!strcmp(o, "--width")) bad = cli_double(v, &width) || width < 8.0;
-        else if (!strcmp(o, "--time")) bad = cli_double(v, &tmax) || tmax <= 0;
-        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
-        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
-        else {
-            fprintf(stderr, "hopper: unknown option %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        if (bad) {
-            fprintf(stderr, "hopper: bad value for %s: %s\n", o, v);
-            usage(stderr);
-            return 2;
-        }
-    }
+    const cli_opt opts[] = {
+        CLI_OPT_ULONG("--n", &n, "N", "number of discs, radii 0.5 and 0.7 +-5%", CLI_ATLEAST(1)),
+        CLI_OPT_DOUBLE("--outlet", &outlet, "D", "outlet width in small diameters", CLI_ABOVE(1)),
+        CLI_OPT_DOUBLE("--width", &width, "W", "box width", CLI_ATLEAST(8)),
+        CLI_TIME(&tmax),
+        CLI_EVERY(&every, "tau"),
+        CLI_SEED(&seed),
+        CLI_SOLVER(&solver_name),
+        CLI_SERIES(&series, SERIES),
+        CLI_SVG(&svg),
+        CLI_OUT(&outpath),
+        CLI_END,
+    };
+    const cli_spec cli = {"hopper", NULL, opts,
+                          "The run ends early when the outlet clogs. The picture (--svg) draws the walls\n"
+                          "grey and the arch dark red.\n"
+                          "Time in units of tau = lambda/(xi0 f_rms) (lambda the mean diameter, f_rms the\n"
+                          "rms weight); the weight of a disc is proportional to its area.\n"
+                          "Exit status 0 whether or not the outlet clogged (stdout says which).\n",
+                          0};
+    int rc = cli_parse(&cli, argc, argv);
+    if (rc != CLI_GO) return rc;
     if (outlet >= width - 2.0) {
         fprintf(stderr, "hopper: the outlet must be narrower than the box\n");
         return 2;
@@ -206,18 +176,14 @@ int main(int argc, char **argv)
     }
     odhs_system *sys;
     CHECK(odhs_system_create(2, n, &sys));
-    int rc = odhs_system_set_configuration(sys, L, 0.0, r, x);
+    rc = odhs_system_set_configuration(sys, L, 0.0, r, x);
     if (rc) {
         fprintf(stderr, "hopper: %s\n", odhs_system_errmsg(sys));
         return 1;
     }
     if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
-    rc = odhs_solver_create_by_name(solver_name, &solver);
-    if (rc) {
-        fprintf(stderr, "hopper: solver %s: %s\n", solver_name, odhs_strerror(rc));
-        return 2;
-    }
+    if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
     odhs_driver *drv;
     odhs_stepper *st;
     CHECK(odhs_driver_create(&drv));
@@ -235,15 +201,8 @@ int main(int argc, char **argv)
     fprintf(stderr, "hopper: N = %lu, outlet %.2f, box %.1f x %.1f, solver %s, tau = %.4g\n", n, outlet, L[0], L[1],
             odhs_solver_name(solver), tau);
 
-    FILE *csv = NULL;
-    if (series) {
-        csv = fopen(series, "w");
-        if (!csv) {
-            fprintf(stderr, "hopper: cannot write %s: %s\n", series, strerror(errno));
-            return 1;
-        }
-        fprintf(csv, "time,discharged,mean_speed,z,events\n");
-    }
+    FILE *csv;
+    if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     double *xp = malloc(2 * n * sizeof *xp), *V = malloc(2 * n * sizeof *V);
     if (!xp || !V) return 1;
     odhs_system_get_positions(sys, xp);

@@ -6,47 +6,17 @@
  *
  *     cc jam_packing.c $(pkg-config --cflags --libs odhs) -lm -o jam_packing
  */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include <odhs.h>
 
 #include "cli.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: jam_packing [options]\n"
-            "  --protocol P       compress | shear | shear+compress | pressure (default compress)\n"
-            "  --in FILE.xyz      start from a configuration file (default: built-in scene)\n"
-            "  --out FILE.xyz     write the jammed packing\n"
-            "  --contacts FILE    write its contacts (i j image force gap)\n"
-            "  --svg FILE.svg     draw it: discs by size, force chains, rattlers marked\n"
-            "  --n N              built-in scene: number of particles (default 256)\n"
-            "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
-            "  --seed S           built-in scene: random seed (default 1)\n"
-            "  --solver NAME      linear solver (default cholmod-pcg when built with\n"
-            "                     SuiteSparse, else dense up to N = 2000 and cg above)\n"
-            "  --integrator I     heun (adaptive, the library's default) or euler (the\n"
-            "                     paper's fixed step) (default heun)\n"
-            "  --tol X            heun: local error tolerance (default 1e-6)\n"
-            "  --dt X             euler: the step; heun: the largest step, in natural\n"
-            "                     units (default 1e-3)\n"
-            "  --max-strain X     shear protocols: give up after this strain (default 20)\n"
-            "  --correction K     drift correction every K steps (default 1: certified\n"
-            "                     packings need contact gaps at round-off when they jam)\n"
-            "  --help             this message\n"
-            "Protocols: compress = isotropic compression; shear = compress to jamming,\n"
-            "dilate by 0.2%% and shear at fixed volume until arrest; shear+compress =\n"
-            "shear with compression at 1/5 of the shear rate; pressure = shear at fixed\n"
-            "pressure, doubled every 0.05 strain (towards zero strain rate).\n"
-            "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed\n"
-            "or not certified (force balance < 1e-12, gaps < 1e-13, no overlap, all\n"
-            "backbone forces > 0, isostatic).\n");
-}
+/* --protocol */
+enum { COMPRESS, SHEAR, SHEAR_COMPRESS, PRESSURE };
+static const char *const protocols[] = {"compress", "shear", "shear+compress", "pressure", NULL};
 
 /* the integration settings of the options */
 static int configure(odhs_stepper *st, int integrator, double dt, double tol, unsigned long corr)
@@ -80,75 +50,49 @@ static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, do
 
 int main(int argc, char **argv)
 {
-    const char *protocol = "compress", *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL,
-               *solver_name = NULL;
+    const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = NULL;
     double dt = 1e-3, max_strain = 20.0, tol = 1e-6;
-    int integrator = ODHS_INTEGRATOR_HEUN;
+    int protocol = COMPRESS, integrator = ODHS_INTEGRATOR_HEUN, dim = 2;
     unsigned long corr = 1;
-    unsigned long n = 256, seed = 1, dim = 2;
-    for (int a = 1; a < argc; ++a) {
-        const char *o = argv[a];
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            usage(stdout);
-            return 0;
-        }
-        if (a + 1 >= argc) {
-            fprintf(stderr, "jam_packing: unknown option or missing value: %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        const char *v = argv[++a];
-        int bad = 0;
-        if (!strcmp(o, "--protocol")) {
-            protocol = v;
-            bad = strcmp(v, "compress") && strcmp(v, "shear") && strcmp(v, "shear+compress") &&
-                  strcmp(v, "pressure");
-        } else if (!strcmp(o, "--in")) in = v;
-        else if (!strcmp(o, "--out")) outpath = v;
-        else if (!strcmp(o, "--contacts")) contacts = v;
-        else if (!strcmp(o, "--svg")) svg = v;
-        else if (!strcmp(o, "--solver")) solver_name = v;
-        else if (!strcmp(o, "--integrator")) {
-            integrator = !strcmp(v, "heun") ? ODHS_INTEGRATOR_HEUN : ODHS_INTEGRATOR_EULER;
-            bad = strcmp(v, "heun") && strcmp(v, "euler");
-        } else if (!strcmp(o, "--tol")) bad = cli_double(v, &tol) || !(tol > 0 && tol < 1);
-        else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
-        else if (!strcmp(o, "--max-strain")) bad = cli_double(v, &max_strain) || max_strain <= 0;
-        else if (!strcmp(o, "--correction")) bad = cli_ulong(v, &corr) || corr > 1000000;
-        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
-        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
-        else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
-        else {
-            fprintf(stderr, "jam_packing: unknown option %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        if (bad) {
-            fprintf(stderr, "jam_packing: bad value for %s: %s\n", o, v);
-            usage(stderr);
-            return 2;
-        }
-    }
+    unsigned long n = 256, seed = 1;
+    const cli_opt opts[] = {
+        CLI_OPT_LIST("--protocol", &protocol, "P", "compress | shear | shear+compress | pressure", protocols, CLI_ANY),
+        CLI_IN(&in),
+        CLI_OUT(&outpath),
+        CLI_OPT_STRING("--contacts", &contacts, "FILE", "write its contacts (i j image force gap)", CLI_ANY),
+        CLI_SVG(&svg),
+        CLI_SCENE(&n, &dim, &seed),
+        CLI_SOLVER(&solver_name),
+        CLI_INTEGRATOR(&integrator),
+        CLI_TOL(&tol),
+        CLI_DT(&dt, "natural units"),
+        CLI_OPT_DOUBLE("--max-strain", &max_strain, "X", "shear protocols: give up after this strain", CLI_POSITIVE),
+        CLI_OPT_ULONG("--correction", &corr, "K",
+                      "drift correction every K steps; certified packings need contact gaps at round-off when they "
+                      "jam",
+                      CLI_ATMOST(1000000)),
+        CLI_END,
+    };
+    const cli_spec cli = {
+        "jam_packing", NULL, opts,
+        "The picture (--svg) marks the rattlers.\n"
+        "Protocols: compress = isotropic compression; shear = compress to jamming,\n"
+        "dilate by 0.2% and shear at fixed volume until arrest; shear+compress =\n"
+        "shear with compression at 1/5 of the shear rate; pressure = shear at fixed\n"
+        "pressure, doubled every 0.05 strain (towards zero strain rate).\n"
+        "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed\n"
+        "or not certified (force balance < 1e-12, gaps < 1e-13, no overlap, all\n"
+        "backbone forces > 0, isostatic).\n",
+        0};
+    int rc = cli_parse(&cli, argc, argv);
+    if (rc != CLI_GO) return rc;
 
     odhs_system *sys = NULL;
-    int rc;
-    if (in) {
-        char err[512];
-        if ((rc = odhs_xyz_read(in, &sys, err, sizeof err))) {
-            fprintf(stderr, "jam_packing: cannot read %s: %s\n", in, err);
-            return 1;
-        }
-    } else if ((rc = cli_scene((int)dim, n, seed, 1.0, &sys))) {
-        fprintf(stderr, "jam_packing: building the scene: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
-        return 1;
-    }
+    if (cli_start(cli.prog, in, dim, n, seed, 1.0, &sys)) return 1;
     n = odhs_system_count(sys);
     if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
-    if ((rc = odhs_solver_create_by_name(solver_name, &solver))) {
-        fprintf(stderr, "jam_packing: solver %s: %s\n", solver_name, odhs_strerror(rc));
-        return 2;
-    }
+    if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
     odhs_driver *drv;
     odhs_stepper *st;
     if (odhs_driver_create(&drv) || odhs_stepper_create(sys, drv, solver, &st) ||
@@ -156,13 +100,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "jam_packing: setup failed\n");
         return 1;
     }
-    fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s, %s\n", n, odhs_system_dim(sys), protocol,
-            solver_name, integrator == ODHS_INTEGRATOR_HEUN ? "heun" : "euler");
+    fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s, %s\n", n, odhs_system_dim(sys),
+            protocols[protocol], solver_name, integrator == ODHS_INTEGRATOR_HEUN ? "heun" : "euler");
 
-    if (!strcmp(protocol, "compress")) {
+    if (protocol == COMPRESS) {
         odhs_driver_set_compression_rate(drv, 1.0);
         rc = drive(st, drv, 0, 0, 0);
-    } else if (!strcmp(protocol, "shear")) {
+    } else if (protocol == SHEAR) {
         odhs_driver_set_compression_rate(drv, 1.0);
         rc = drive(st, drv, 0, 0, 0);
         if (rc == ODHS_JAMMED) {
@@ -179,7 +123,7 @@ int main(int argc, char **argv)
                     phi / 1.002);
             rc = drive(st, drv, 1, 0, max_strain);
         }
-    } else if (!strcmp(protocol, "shear+compress")) {
+    } else if (protocol == SHEAR_COMPRESS) {
         odhs_driver_set_shear_rate(drv, 1.0);
         odhs_driver_set_compression_rate(drv, 0.2);
         rc = drive(st, drv, 0, 0, 0);

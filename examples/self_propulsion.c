@@ -14,7 +14,6 @@
  * Build against an installed libodhs:
  *     cc self_propulsion.c $(pkg-config --cflags --libs odhs) -lm -o self_propulsion
  */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,30 +23,8 @@
 
 #include "cli.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: self_propulsion [options]\n"
-            "  --in FILE.xyz      start from a configuration file (default: built-in scene)\n"
-            "  --time X           run length in units of tau (default 20)\n"
-            "  --tmax X           persistence times uniform in [0, X] tau (default 10)\n"
-            "  --every X          output interval in tau (default 1)\n"
-            "  --series FILE.csv  write time,mean_speed,pressure,z,collisions,openings\n"
-            "  --svg FILE.svg     picture of the final state (like Fig. 8 of the paper)\n"
-            "  --out FILE.xyz     write the final configuration\n"
-            "  --dt X             step in units of tau (default 1e-2; steps also end at\n"
-            "                     every switch of a propulsion force)\n"
-            "  --solver NAME      linear solver: cg, dense, cholmod, cholmod-pcg, spqr\n"
-            "                     (default cholmod-pcg when built with SuiteSparse, else\n"
-            "                     dense up to N = 2000 and cg above)\n"
-            "  --n N              built-in scene: number of particles (default 256)\n"
-            "  --phi X            built-in scene: packing fraction (default 0.5)\n"
-            "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
-            "  --seed S           random seed of the scene and the forces (default 1)\n"
-            "  --help             this message\n"
-            "Lengths are in units of the mean diameter lambda, times in tau = lambda/(f_ext xi0),\n"
-            "speeds in lambda/tau, pressure in f_ext/lambda^(d-1).\n");
-}
+/* the --series columns */
+#define SERIES "time,mean_speed,pressure,z,collisions,openings"
 
 #define CHECK(call)                                                                             \
     do {                                                                                        \
@@ -141,57 +118,39 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = NULL;
     double T = 20.0, tmax = 10.0, every = 1.0, dt = 1e-2, phi = 0.5;
-    unsigned long n = 256, seed = 1, dim = 2;
-    for (int a = 1; a < argc; ++a) {
-        const char *o = argv[a];
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            usage(stdout);
-            return 0;
-        }
-        if (a + 1 >= argc) {
-            fprintf(stderr, "self_propulsion: unknown option or missing value: %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        const char *v = argv[++a];
-        int bad = 0;
-        if (!strcmp(o, "--in")) in = v;
-        else if (!strcmp(o, "--out")) outpath = v;
-        else if (!strcmp(o, "--series")) series = v;
-        else if (!strcmp(o, "--svg")) svg = v;
-        else if (!strcmp(o, "--solver")) solver_name = v;
-        else if (!strcmp(o, "--time")) bad = cli_double(v, &T) || T <= 0;
-        else if (!strcmp(o, "--tmax")) bad = cli_double(v, &tmax) || tmax <= 0;
-        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
-        else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
-        else if (!strcmp(o, "--phi")) bad = cli_double(v, &phi) || phi <= 0 || phi >= 1;
-        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
-        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
-        else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
-        else {
-            fprintf(stderr, "self_propulsion: unknown option %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        if (bad) {
-            fprintf(stderr, "self_propulsion: bad value for %s: %s\n", o, v);
-            usage(stderr);
-            return 2;
-        }
-    }
+    unsigned long n = 256, seed = 1;
+    int dim = 2;
+    const cli_opt opts[] = {
+        CLI_IN(&in),
+        CLI_TIME(&T),
+        CLI_OPT_DOUBLE("--tmax", &tmax, "X", "persistence times uniform in [0, X] tau", CLI_POSITIVE),
+        CLI_EVERY(&every, "tau"),
+        CLI_SERIES(&series, SERIES),
+        CLI_SVG(&svg),
+        CLI_OUT(&outpath),
+        CLI_DT(&dt, "units of tau"),
+        CLI_SOLVER(&solver_name),
+        CLI_PHI(&phi),
+        CLI_SCENE(&n, &dim, &seed),
+        CLI_END,
+    };
+    const cli_spec cli = {
+        "self_propulsion", NULL, opts,
+        "The seed also draws the propulsion forces; steps also end at every switch of a\n"
+        "propulsion force. The picture (--svg) is like Fig. 8 of the paper, with the\n"
+        "propulsion forces as green arrows (2D).\n"
+        "Lengths are in units of the mean diameter lambda, times in\n"
+        "tau = lambda/(f_ext xi0), speeds in lambda/tau, pressure in f_ext/lambda^(d-1).\n",
+        0};
+    int rc = cli_parse(&cli, argc, argv);
+    if (rc != CLI_GO) return rc;
 
     odhs_system *sys = NULL;
-    int rc;
     if (in) {
-        char err[512];
-        rc = odhs_xyz_read(in, &sys, err, sizeof err);
-        if (rc) {
-            fprintf(stderr, "self_propulsion: cannot read %s: %s\n", in, err);
-            return 1;
-        }
+        if (cli_read_xyz(cli.prog, in, &sys)) return 1;
     } else {
         /* uniform polydispersity: the "bidisperse" builder with ratio 1 */
-        rc = odhs_system_create((int)dim, n, &sys);
+        rc = odhs_system_create(dim, n, &sys);
         if (!rc) rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.0, 0.03, seed);
         if (!rc) rc = odhs_system_place_random(sys, phi, seed + 1);
         if (rc) {
@@ -203,11 +162,7 @@ int main(int argc, char **argv)
     int d = odhs_system_dim(sys);
     if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
-    rc = odhs_solver_create_by_name(solver_name, &solver);
-    if (rc) {
-        fprintf(stderr, "self_propulsion: solver %s: %s\n", solver_name, odhs_strerror(rc));
-        return 2;
-    }
+    if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
     double phi_now, *r = malloc(n * sizeof *r), lambda = 0.0;
     CHECK(odhs_system_packing_fraction(sys, &phi_now));
     CHECK(odhs_system_get_radii(sys, r));
@@ -231,15 +186,8 @@ int main(int argc, char **argv)
         return 1;
     }
 
-    FILE *csv = NULL;
-    if (series) {
-        csv = fopen(series, "w");
-        if (!csv) {
-            fprintf(stderr, "self_propulsion: cannot write %s: %s\n", series, strerror(errno));
-            return 1;
-        }
-        fprintf(csv, "time,mean_speed,pressure,z,collisions,openings\n");
-    }
+    FILE *csv;
+    if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     printf("%10s %12s %14s %8s %10s %10s\n", "time", "mean_speed", "pressure", "z", "collisions", "openings");
     double *V = malloc(n * d * sizeof *V);
     long nout = (long)ceil(T / every - 1e-9);

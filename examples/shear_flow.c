@@ -8,44 +8,15 @@
  * Build against an installed libodhs:
  *     cc shear_flow.c $(pkg-config --cflags --libs odhs) -lm -o shear_flow
  */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
 
 #include <odhs.h>
 
 #include "cli.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: shear_flow [options]\n"
-            "  --in FILE.xyz      start from a configuration file (extended XYZ)\n"
-            "  --strain X         total strain (default 0.2)\n"
-            "  --out FILE.xyz     write the final configuration\n"
-            "  --svg FILE.svg     picture of the final state (discs coloured by size,\n"
-            "                     contact forces as lines of width proportional to the force)\n"
-            "  --series FILE.csv  write strain,shear_stress,pressure,z,events per interval\n"
-            "  --every X          output interval in strain (default 0.01)\n"
-            "  --dt X             step in strain units (default 1e-3; the largest step\n"
-            "                     with --integrator heun)\n"
-            "  --integrator NAME  euler (the paper's fixed step) or heun (adaptive)\n"
-            "                     (default euler)\n"
-            "  --tol X            heun: error per step relative to the mean diameter\n"
-            "                     (default 1e-6)\n"
-            "  --solver NAME      linear solver: cg, dense, cholmod, cholmod-pcg, spqr\n"
-            "                     (default cg, the paper's choice)\n"
-            "  --pressure P       shear at fixed pressure P instead of fixed volume\n"
-            "  --n N              built-in scene: number of particles (default 256)\n"
-            "  --phi X            built-in scene: packing fraction (default 0.80)\n"
-            "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
-            "  --seed S           built-in scene: random seed (default 1)\n"
-            "  --help             this message\n"
-            "Forces are in units of lambda*gammadot/xi0 with lambda the small diameter;\n"
-            "stresses in units of gammadot/xi0 (2D: per length, 3D: per area).\n");
-}
+/* the --series columns */
+#define SERIES "strain,shear_stress,pressure,z,events"
 
 #define CHECK(call)                                                                             \
     do {                                                                                        \
@@ -98,69 +69,40 @@ static int build_scene(int dim, unsigned long n, double phi, unsigned long seed,
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = "cg", *integrator = "euler";
+    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = "cg";
     double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 1e-6;
-    unsigned long n = 256, seed = 1, dim = 2;
-    for (int a = 1; a < argc; ++a) {
-        const char *o = argv[a];
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            usage(stdout);
-            return 0;
-        }
-        if (a + 1 >= argc) {
-            fprintf(stderr, "shear_flow: unknown option or missing value: %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        const char *v = argv[++a];
-        int bad = 0;
-        if (!strcmp(o, "--in")) in = v;
-        else if (!strcmp(o, "--out")) outpath = v;
-        else if (!strcmp(o, "--series")) series = v;
-        else if (!strcmp(o, "--svg")) svg = v;
-        else if (!strcmp(o, "--solver")) solver_name = v;
-        else if (!strcmp(o, "--integrator")) {
-            integrator = v;
-            bad = strcmp(v, "euler") && strcmp(v, "heun");
-        } else if (!strcmp(o, "--tol")) bad = cli_double(v, &tol) || tol <= 0 || tol >= 1;
-        else if (!strcmp(o, "--strain")) bad = cli_double(v, &strain) || strain <= 0;
-        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
-        else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0;
-        else if (!strcmp(o, "--pressure")) bad = cli_double(v, &pressure) || pressure <= 0;
-        else if (!strcmp(o, "--phi")) bad = cli_double(v, &phi) || phi <= 0 || phi >= 1;
-        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
-        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
-        else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
-        else {
-            fprintf(stderr, "shear_flow: unknown option %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        if (bad) {
-            fprintf(stderr, "shear_flow: bad value for %s: %s\n", o, v);
-            usage(stderr);
-            return 2;
-        }
-    }
+    unsigned long n = 256, seed = 1;
+    int dim = 2, integrator = ODHS_INTEGRATOR_EULER;
+    const cli_opt opts[] = {
+        CLI_IN(&in),
+        CLI_STRAIN(&strain),
+        CLI_OUT(&outpath),
+        CLI_SVG(&svg),
+        CLI_SERIES(&series, SERIES),
+        CLI_EVERY(&every, "strain"),
+        CLI_DT(&dt, "strain units"),
+        CLI_INTEGRATOR(&integrator),
+        CLI_TOL(&tol),
+        CLI_SOLVER(&solver_name),
+        CLI_OPT_DOUBLE("--pressure", &pressure, "P", "shear at fixed pressure P instead of fixed volume", CLI_POSITIVE,
+                       .deftext = ""),
+        CLI_PHI(&phi),
+        CLI_SCENE(&n, &dim, &seed),
+        CLI_END,
+    };
+    const cli_spec cli = {"shear_flow", NULL, opts,
+                          "The default solver and integrator, cg and euler, are the paper's choices.\n"
+                          "Forces are in units of lambda*gammadot/xi0 with lambda the small diameter;\n"
+                          "stresses in units of gammadot/xi0 (2D: per length, 3D: per area).\n",
+                          0};
+    int rc = cli_parse(&cli, argc, argv);
+    if (rc != CLI_GO) return rc;
 
     odhs_solver *solver;
-    int rc = odhs_solver_create_by_name(solver_name, &solver);
-    if (rc) {
-        fprintf(stderr, "shear_flow: solver %s: %s\n", solver_name, odhs_strerror(rc));
-        return 2;
-    }
+    if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
 
     odhs_system *sys = NULL;
-    if (in) {
-        char err[512];
-        rc = odhs_xyz_read(in, &sys, err, sizeof err);
-        if (rc) {
-            fprintf(stderr, "shear_flow: cannot read %s: %s\n", in, err);
-            return 1;
-        }
-    } else if (build_scene((int)dim, n, phi, seed, solver, &sys)) {
-        return 1;
-    }
+    if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, solver, &sys)) return 1;
     double phi_now;
     CHECK(odhs_system_packing_fraction(sys, &phi_now));
     n = odhs_system_count(sys);
@@ -174,7 +116,7 @@ int main(int argc, char **argv)
     if (pressure > 0) CHECK(odhs_driver_set_pressure(drv, pressure));
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
     CHECK(odhs_stepper_set_dt(st, dt));
-    CHECK(odhs_stepper_set_integrator(st, strcmp(integrator, "heun") ? ODHS_INTEGRATOR_EULER : ODHS_INTEGRATOR_HEUN));
+    CHECK(odhs_stepper_set_integrator(st, integrator));
     CHECK(odhs_stepper_set_tolerance(st, tol));
     rc = odhs_stepper_reset(st);
     if (rc) {
@@ -182,15 +124,8 @@ int main(int argc, char **argv)
         return 1;
     }
 
-    FILE *csv = NULL;
-    if (series) {
-        csv = fopen(series, "w");
-        if (!csv) {
-            fprintf(stderr, "shear_flow: cannot write %s: %s\n", series, strerror(errno));
-            return 1;
-        }
-        fprintf(csv, "strain,shear_stress,pressure,z,events\n");
-    }
+    FILE *csv;
+    if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     printf("%12s %14s %14s %8s %10s%s\n", "strain", "shear_stress", "pressure", "z", "events",
            pressure > 0 ? "        phi" : "");
     double g0;

@@ -10,49 +10,16 @@
  * Build against an installed libodhs:
  *     cc softcore_shear.c $(pkg-config --cflags --libs odhs) -lm -o softcore_shear
  */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include <odhs.h>
 
 #include "cli.h"
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: softcore_shear [options]\n"
-            "  --model NAME       rd0, cd0 (overdamped), qs-sd, qs-fire, qs-cg (quasistatic:\n"
-            "                     strain step + steepest descent / FIRE / Polak-Ribiere CG),\n"
-            "                     rd, cd, cdn, cdt (massive, SLLOD) (default rd0)\n"
-            "  --rate X           shear rate in units of 1/tau_e, tau_e = k_d d_min^2/k_e\n"
-            "                     (default 1e-5; time-stepped models)\n"
-            "  --dgamma X         quasistatic strain step (default 1e-4)\n"
-            "  --strain X         total strain (default 0.02)\n"
-            "  --every X          output interval in strain (default 0.002)\n"
-            "  --in FILE.xyz      start from a configuration file (extended XYZ)\n"
-            "  --out FILE.xyz     write the final configuration (it may overlap)\n"
-            "  --series FILE.csv  write strain,shear_stress,pressure,energy,z,max_overlap\n"
-            "  --alpha A          potential exponent: 2 harmonic, 2.5 Hertzian (default 2)\n"
-            "  --kd X             drag coefficient k_d (default 1)\n"
-            "  --k0 X             CD0 substrate drag k_0 (default 1e-3)\n"
-            "  --mass X           particle mass of the massive models (default 1)\n"
-            "  --dt X             step factor (fraction of tau_e or tau_m; default 0.1)\n"
-            "  --integrator NAME  fixed or adaptive (overdamped models; default fixed)\n"
-            "  --tol X            adaptive: error per step / mean diameter (default 1e-6);\n"
-            "                     quasistatic: largest force at the minimum (default 1e-9)\n"
-            "  --n N              built-in scene: number of particles (default 256)\n"
-            "  --phi X            built-in scene: packing fraction (default 0.80)\n"
-            "  --dim D            built-in scene: dimension 2 or 3 (default 2)\n"
-            "  --seed S           built-in scene: random seed (default 1)\n"
-            "  --help             this message\n"
-            "Units: k_e = 1 (energy), small diameter 1 (length), k_d (drag): stresses are\n"
-            "in k_e per area (2D) or volume (3D); the quasistatic models print the\n"
-            "relaxation stress (1/dgamma) integral sigma dt (qs-sd) in k_d units, which\n"
-            "is the hard-sphere stress at unit shear rate.\n");
-}
+/* the --series columns */
+#define SERIES "strain,shear_stress,pressure,energy,z,max_overlap"
 
 #define CHECK(call)                                                                             \
     do {                                                                                        \
@@ -96,93 +63,76 @@ static int build_scene(int dim, unsigned long n, double phi, unsigned long seed,
     return 0;
 }
 
+/* --model: the names, and the models by the same index */
+static const char *const model_names[] = {"rd0", "cd0", "qs-sd", "qs-fire", "qs-cg", "rd", "cd", "cdn", "cdt", NULL};
 static const struct {
-    const char *name;
     int model, qs, minimiser;
 } models[] = {
-    {"rd0", ODHS_SOFTCORE_RD0, 0, 0},
-    {"cd0", ODHS_SOFTCORE_CD0, 0, 0},
-    {"qs-sd", ODHS_SOFTCORE_RD0, 1, ODHS_SOFTCORE_SD},
-    {"qs-fire", ODHS_SOFTCORE_RD0, 1, ODHS_SOFTCORE_FIRE},
-    {"qs-cg", ODHS_SOFTCORE_RD0, 1, ODHS_SOFTCORE_CG},
-    {"rd", ODHS_SOFTCORE_RD, 0, 0},
-    {"cd", ODHS_SOFTCORE_CD, 0, 0},
-    {"cdn", ODHS_SOFTCORE_CDN, 0, 0},
-    {"cdt", ODHS_SOFTCORE_CDT, 0, 0},
+    {ODHS_SOFTCORE_RD0, 0, 0},
+    {ODHS_SOFTCORE_CD0, 0, 0},
+    {ODHS_SOFTCORE_RD0, 1, ODHS_SOFTCORE_SD},
+    {ODHS_SOFTCORE_RD0, 1, ODHS_SOFTCORE_FIRE},
+    {ODHS_SOFTCORE_RD0, 1, ODHS_SOFTCORE_CG},
+    {ODHS_SOFTCORE_RD, 0, 0},
+    {ODHS_SOFTCORE_CD, 0, 0},
+    {ODHS_SOFTCORE_CDN, 0, 0},
+    {ODHS_SOFTCORE_CDT, 0, 0},
 };
+_Static_assert(sizeof models / sizeof models[0] + 1 == sizeof model_names / sizeof model_names[0],
+               "one name per model");
+
+/* --integrator, indexed by the enum */
+static const char *const integrators[] = {"fixed", "adaptive", NULL};
+_Static_assert(ODHS_SOFTCORE_FIXED == 0 && ODHS_SOFTCORE_ADAPTIVE == 1, "integrators is indexed by the enum");
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *model = "rd0", *integrator = "fixed";
+    const char *in = NULL, *outpath = NULL, *series = NULL;
     double rate = 1e-5, dgamma = 1e-4, strain = 0.02, every = 0.002, alpha = 2.0, kd = 1.0, k0 = 1e-3;
     double mass = 1.0, dt = 0.1, tol = -1.0, phi = 0.80;
-    unsigned long n = 256, seed = 1, dim = 2;
-    for (int a = 1; a < argc; ++a) {
-        const char *o = argv[a];
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            usage(stdout);
-            return 0;
-        }
-        if (a + 1 >= argc) {
-            fprintf(stderr, "softcore_shear: unknown option or missing value: %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        const char *v = argv[++a];
-        int bad = 0;
-        if (!strcmp(o, "--in")) in = v;
-        else if (!strcmp(o, "--out")) outpath = v;
-        else if (!strcmp(o, "--series")) series = v;
-        else if (!strcmp(o, "--model")) {
-            model = v;
-            bad = 1;
-            for (size_t k = 0; k < sizeof models / sizeof models[0]; ++k)
-                if (!strcmp(v, models[k].name)) bad = 0;
-        } else if (!strcmp(o, "--integrator")) {
-            integrator = v;
-            bad = strcmp(v, "fixed") && strcmp(v, "adaptive");
-        } else if (!strcmp(o, "--rate")) bad = cli_double(v, &rate) || rate <= 0;
-        else if (!strcmp(o, "--dgamma")) bad = cli_double(v, &dgamma) || dgamma <= 0 || dgamma > 0.1;
-        else if (!strcmp(o, "--strain")) bad = cli_double(v, &strain) || strain <= 0;
-        else if (!strcmp(o, "--every")) bad = cli_double(v, &every) || every <= 0;
-        else if (!strcmp(o, "--alpha")) bad = cli_double(v, &alpha) || alpha <= 1 || alpha > 10;
-        else if (!strcmp(o, "--kd")) bad = cli_double(v, &kd) || kd <= 0;
-        else if (!strcmp(o, "--k0")) bad = cli_double(v, &k0) || k0 < 0;
-        else if (!strcmp(o, "--mass")) bad = cli_double(v, &mass) || mass <= 0;
-        else if (!strcmp(o, "--dt")) bad = cli_double(v, &dt) || dt <= 0 || dt > 10;
-        else if (!strcmp(o, "--tol")) bad = cli_double(v, &tol) || tol <= 0;
-        else if (!strcmp(o, "--phi")) bad = cli_double(v, &phi) || phi <= 0 || phi >= 1;
-        else if (!strcmp(o, "--n")) bad = cli_ulong(v, &n) || n < 2;
-        else if (!strcmp(o, "--seed")) bad = cli_ulong(v, &seed);
-        else if (!strcmp(o, "--dim")) bad = cli_ulong(v, &dim) || (dim != 2 && dim != 3);
-        else {
-            fprintf(stderr, "softcore_shear: unknown option %s\n", o);
-            usage(stderr);
-            return 2;
-        }
-        if (bad) {
-            fprintf(stderr, "softcore_shear: bad value for %s: %s\n", o, v);
-            usage(stderr);
-            return 2;
-        }
-    }
-    int mi = 0;
-    for (size_t k = 0; k < sizeof models / sizeof models[0]; ++k)
-        if (!strcmp(model, models[k].name)) mi = (int)k;
+    unsigned long n = 256, seed = 1;
+    int mi = 0, integrator = ODHS_SOFTCORE_FIXED, dim = 2;
+    const cli_opt opts[] = {
+        CLI_OPT_LIST("--model", &mi, "NAME",
+                     "rd0, cd0 (overdamped), qs-sd, qs-fire, qs-cg (quasistatic: strain step + steepest descent / "
+                     "FIRE / Polak-Ribiere CG), rd, cd, cdn, cdt (massive, SLLOD)",
+                     model_names, CLI_ANY),
+        CLI_OPT_DOUBLE("--rate", &rate, "X",
+                       "shear rate in units of 1/tau_e, tau_e = k_d d_min^2/k_e (time-stepped models)", CLI_POSITIVE),
+        CLI_OPT_DOUBLE("--dgamma", &dgamma, "X", "quasistatic strain step", CLI_ABOVE_ATMOST(0, 0.1)),
+        CLI_STRAIN(&strain),
+        CLI_EVERY(&every, "strain"),
+        CLI_IN(&in),
+        CLI_OUT(&outpath),
+        CLI_SERIES(&series, SERIES),
+        CLI_OPT_DOUBLE("--alpha", &alpha, "A", "potential exponent: 2 harmonic, 2.5 Hertzian", CLI_ABOVE_ATMOST(1, 10)),
+        CLI_OPT_DOUBLE("--kd", &kd, "X", "drag coefficient k_d", CLI_POSITIVE),
+        CLI_OPT_DOUBLE("--k0", &k0, "X", "CD0 substrate drag k_0", CLI_NONNEGATIVE),
+        CLI_OPT_DOUBLE("--mass", &mass, "X", "particle mass of the massive models", CLI_POSITIVE),
+        CLI_OPT_DOUBLE("--dt", &dt, "X", "step factor (fraction of tau_e or tau_m)", CLI_ABOVE_ATMOST(0, 10)),
+        CLI_OPT_LIST("--integrator", &integrator, "NAME", "fixed or adaptive (overdamped models)", integrators, CLI_ANY),
+        CLI_OPT_DOUBLE("--tol", &tol, "X",
+                       "adaptive: error per step / mean diameter (default 1e-6); quasistatic: largest force at the "
+                       "minimum (default 1e-9)",
+                       CLI_POSITIVE, .deftext = ""),
+        CLI_PHI(&phi),
+        CLI_SCENE(&n, &dim, &seed),
+        CLI_END,
+    };
+    const cli_spec cli = {
+        "softcore_shear", NULL, opts,
+        "The final configuration (--out) may overlap.\n"
+        "Units: k_e = 1 (energy), small diameter 1 (length), k_d (drag): stresses are\n"
+        "in k_e per area (2D) or volume (3D); the quasistatic models print the\n"
+        "relaxation stress (1/dgamma) integral sigma dt (qs-sd) in k_d units, which\n"
+        "is the hard-sphere stress at unit shear rate.\n",
+        0};
+    int rc = cli_parse(&cli, argc, argv);
+    if (rc != CLI_GO) return rc;
     int qs = models[mi].qs;
 
     odhs_system *sys = NULL;
-    int rc;
-    if (in) {
-        char err[512];
-        rc = odhs_xyz_read(in, &sys, err, sizeof err);
-        if (rc) {
-            fprintf(stderr, "softcore_shear: cannot read %s: %s\n", in, err);
-            return 1;
-        }
-    } else if (build_scene((int)dim, n, phi, seed, &sys)) {
-        return 1;
-    }
+    if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, &sys)) return 1;
     n = odhs_system_count(sys);
     double phi_now, r_min = INFINITY;
     CHECK(odhs_system_packing_fraction(sys, &phi_now));
@@ -203,7 +153,7 @@ int main(int argc, char **argv)
     CHECK(odhs_softcore_set_substrate(sc, k0));
     CHECK(odhs_softcore_set_mass(sc, mass));
     CHECK(odhs_softcore_set_dt(sc, dt));
-    CHECK(odhs_softcore_set_integrator(sc, strcmp(integrator, "adaptive") ? ODHS_SOFTCORE_FIXED : ODHS_SOFTCORE_ADAPTIVE));
+    CHECK(odhs_softcore_set_integrator(sc, integrator));
     if (qs) {
         CHECK(odhs_softcore_set_minimiser(sc, models[mi].minimiser));
         CHECK(odhs_softcore_set_min_tolerance(sc, tol > 0 ? tol : 1e-9, 100000000u));
@@ -218,17 +168,10 @@ int main(int argc, char **argv)
         CHECK(odhs_softcore_set_shear_rate(sc, rate / tau_e));
     }
     fprintf(stderr, "softcore_shear: N = %lu, d = %d, phi = %.6f, model %s, %s %g\n", n, odhs_system_dim(sys),
-            phi_now, model, qs ? "dgamma" : "gammadot tau_e", qs ? dgamma : rate);
+            phi_now, model_names[mi], qs ? "dgamma" : "gammadot tau_e", qs ? dgamma : rate);
 
-    FILE *csv = NULL;
-    if (series) {
-        csv = fopen(series, "w");
-        if (!csv) {
-            fprintf(stderr, "softcore_shear: cannot write %s: %s\n", series, strerror(errno));
-            return 1;
-        }
-        fprintf(csv, "strain,shear_stress,pressure,energy,z,max_overlap\n");
-    }
+    FILE *csv;
+    if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     printf("%12s %14s %14s %14s %8s %12s\n", "strain", qs ? "relax_stress" : "shear_stress", "pressure", "energy",
            "z", "max_overlap");
     long nout = (long)ceil(strain / every - 1e-9);

@@ -119,5 +119,37 @@ for m in cd0 qs-sd qs-fire qs-cg rd cd cdn cdt; do
 done
 expect 0 "softcore_shear 3D hertzian adaptive" -- "$bin/softcore_shear" --dim 3 --n 32 --phi 0.4 --alpha 2.5 \
     --integrator adaptive --strain 0.002 --every 0.001 --rate 1e-3
+# the shared option table (examples/cli.h): -h is --help, the usage fits in
+# 80 columns, shows the defaults (not values given before --help), names a
+# bad value, and the common options read the same in every example
+for prog in shear_flow compress self_propulsion composite hopper jam_packing softcore_shear sweep_serial; do
+    expect 0 "$prog -h" -- "$bin/$prog" -h
+    expect_in out "^usage: " "$prog -h prints usage"
+    awk 'length($0) > 80 { bad = 1 } END { exit bad }' "$tmp/out" && pass=$((pass + 1)) \
+        || { echo "FAIL: $prog usage wider than 80 columns"; fail=$((fail + 1)); }
+    expect_in out "^  --help  *this message$" "$prog usage lists --help"
+done
+for prog in shear_flow compress self_propulsion composite hopper jam_packing; do
+    "$bin/$prog" --help > "$tmp/out"
+    expect_in out "^  --seed S  *random seed (default 1)$" "$prog --seed reads as in the other examples"
+    expect_in out "^  --solver NAME  *linear solver: cg, dense, cholmod, cholmod-pcg, spqr$" "$prog --solver reads as in the other examples"
+    expect_in out "^  --out FILE.xyz  *write the final configuration (extended XYZ)$" "$prog --out reads as in the other examples"
+done
+for prog in shear_flow compress self_propulsion jam_packing softcore_shear; do
+    "$bin/$prog" --help > "$tmp/out"
+    expect_in out "^  --n N  *built-in scene: number of particles (default 256)$" "$prog --n reads as in the other examples"
+    expect_in out "^  --dim D  *built-in scene: dimension 2 or 3 (default 2)$" "$prog --dim reads as in the other examples"
+done
+expect 0 "shear_flow values before --help" -- "$bin/shear_flow" --n 5 --dim 3 --help
+expect_in out "number of particles (default 256)" "shear_flow --help shows the default, not the value given"
+expect 2 "shear_flow bad dt names it" -- "$bin/shear_flow" --dt abc
+expect_in err "^shear_flow: bad value for --dt: abc$" "shear_flow names the bad value"
+expect 2 "compress unknown option with a value" -- "$bin/compress" --colour red
+expect_in err "^compress: unknown option --colour$" "compress names the unknown option"
+expect 2 "jam_packing missing value" -- "$bin/jam_packing" --seed
+expect_in err "^jam_packing: unknown option or missing value: --seed$" "jam_packing names the option without a value"
+expect 2 "softcore_shear bad integrator" -- "$bin/softcore_shear" --integrator heun
+expect 2 "sweep_serial unknown solver usage" -- "$bin/sweep_serial" --solver nonsense
+expect_in err "(default cholmod when built in, else cg)" "sweep_serial usage after a bad solver shows the default"
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

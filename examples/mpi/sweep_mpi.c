@@ -79,35 +79,6 @@ static const char *default_campaign =
     "64,2,0.76,,1,0.5,volume\n"
     "64,2,0.76,,2,0.5,volume\n";
 
-static void usage(FILE *f)
-{
-    fprintf(f,
-            "usage: sweep_mpi [options]   (under MPI: mpirun -np R sweep_mpi [options])\n"
-            "  --campaign FILE.csv  runs, one per row; header names the columns\n"
-            "                       n,dim,phi,pressure,seed,strain,driver (any order;\n"
-            "                       dim defaults to 2, driver to volume, or to pressure when\n"
-            "                       a pressure is given); driver volume shears at fixed\n"
-            "                       volume at phi, driver pressure compresses to phi and\n"
-            "                       shears at fixed pressure. Default: a built-in demo of\n"
-            "                       4 runs (N = 64, phi 0.70 and 0.76, 2 seeds)\n"
-            "  --out DIR            output directory (default sweep_out); re-running the\n"
-            "                       same command resumes the campaign found there\n"
-            "  --every X            sampling interval in strain (default 0.01)\n"
-            "  --transient X        strain discarded before averaging (default 0.2)\n"
-            "  --checkpoint X       strain between checkpoints (default 0.1, rounded to a\n"
-            "                       multiple of --every)\n"
-            "  --dt X               step in strain units (default 1e-3)\n"
-            "  --solver NAME        cholmod (default when built in, else cg), cg, dense,\n"
-            "                       spqr; cholmod-pcg works but keeps state, so a resumed\n"
-            "                       run is then not bit-identical\n"
-            "  --quiet              no per-run progress lines\n"
-            "  --help               this message\n"
-            "Units: lengths in small-particle diameters, gammadot = 1, xi0 = 1; stresses in\n"
-            "gammadot/xi0 (2D: per length, 3D: per area); eta = sigma_xy/gammadot.\n"
-            "Exit status: 0 all runs ok, 3 campaign complete but some runs failed (see\n"
-            "runs.csv), 1 fatal error, 2 bad usage or campaign file.\n");
-}
-
 /* the rank prefix of every message */
 static int g_rank = 0;
 #define LOG(...)                                                                                   \
@@ -1039,42 +1010,35 @@ int main(int argc, char **argv)
     MPI_Comm_size(MPI_COMM_WORLD, &S.size);
 #endif
     g_rank = S.rank;
-    int status = 0;
-    for (int a = 1; a < argc && !status; ++a) {
-        const char *o = argv[a];
-        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
-            if (S.rank == 0) usage(stdout);
-            status = -1;
-            break;
-        }
-        if (!strcmp(o, "--quiet")) {
-            S.quiet = 1;
-            continue;
-        }
-        if (a + 1 >= argc) {
-            if (S.rank == 0) fprintf(stderr, PROG ": unknown option or missing value: %s\n", o), usage(stderr);
-            status = 2;
-            break;
-        }
-        const char *v = argv[++a];
-        int bad = 0;
-        if (!strcmp(o, "--campaign")) S.campaign = v;
-        else if (!strcmp(o, "--out")) S.out = v;
-        else if (!strcmp(o, "--solver")) S.solver = v;
-        else if (!strcmp(o, "--every")) bad = cli_double(v, &S.every) || S.every <= 0;
-        else if (!strcmp(o, "--transient")) bad = cli_double(v, &S.transient) || S.transient < 0;
-        else if (!strcmp(o, "--checkpoint")) bad = cli_double(v, &S.checkpoint) || S.checkpoint <= 0;
-        else if (!strcmp(o, "--dt")) bad = cli_double(v, &S.dt) || S.dt <= 0;
-        else {
-            if (S.rank == 0) fprintf(stderr, PROG ": unknown option %s\n", o), usage(stderr);
-            status = 2;
-            break;
-        }
-        if (bad) {
-            if (S.rank == 0) fprintf(stderr, PROG ": bad value for %s: %s\n", o, v), usage(stderr);
-            status = 2;
-        }
-    }
+    const cli_opt opts[] = {
+        CLI_OPT_STRING("--campaign", &S.campaign, "FILE.csv",
+                       "runs, one per row; header names the columns n,dim,phi,pressure,seed,strain,driver (any "
+                       "order; dim defaults to 2, driver to volume, or to pressure when a pressure is given); driver "
+                       "volume shears at fixed volume at phi, driver pressure compresses to phi and shears at fixed "
+                       "pressure",
+                       .deftext = "4 built-in runs, N = 64, phi 0.70/0.76, 2 seeds"),
+        CLI_OPT_STRING("--out", &S.out, "DIR",
+                       "output directory; re-running the same command resumes the campaign found there", CLI_ANY),
+        CLI_EVERY(&S.every, "strain"),
+        CLI_OPT_DOUBLE("--transient", &S.transient, "X", "strain discarded before averaging", CLI_NONNEGATIVE),
+        CLI_OPT_DOUBLE("--checkpoint", &S.checkpoint, "X", "strain between checkpoints, rounded to a multiple of --every",
+                       CLI_POSITIVE),
+        CLI_DT(&S.dt, "strain units"),
+        CLI_OPT_STRING("--solver", &S.solver, "NAME", CLI_SOLVER_HELP, .deftext = "cholmod when built in, else cg"),
+        CLI_OPT_FLAG("--quiet", &S.quiet, "no per-run progress lines"),
+        CLI_END,
+    };
+    const cli_spec cli = {
+        PROG, "[options]   (under MPI: mpirun -np R sweep_mpi [options])", opts,
+        "cholmod-pcg works but keeps state, so a resumed run is then not bit-identical.\n"
+        "Units: lengths in small-particle diameters, gammadot = 1, xi0 = 1; stresses in\n"
+        "gammadot/xi0 (2D: per length, 3D: per area); eta = sigma_xy/gammadot.\n"
+        "Exit status: 0 all runs ok, 3 campaign complete but some runs failed (see\n"
+        "runs.csv), 1 fatal error, 2 bad usage or campaign file.\n",
+        S.rank != 0};
+    /* status: 0 go on, -1 after --help (exit 0), else the exit status */
+    int status = cli_parse(&cli, argc, argv);
+    status = status == CLI_GO ? 0 : status == 0 ? -1 : status;
     if (!S.solver) {
         odhs_solver *s;
         S.solver = odhs_solver_create_by_name("cholmod", &s) == ODHS_OK ? "cholmod" : "cg";
@@ -1083,7 +1047,7 @@ int main(int argc, char **argv)
         odhs_solver *s;
         int rc = odhs_solver_create_by_name(S.solver, &s);
         if (rc) {
-            if (S.rank == 0) fprintf(stderr, PROG ": solver %s: %s\n", S.solver, odhs_strerror(rc)), usage(stderr);
+            if (S.rank == 0) fprintf(stderr, PROG ": solver %s: %s\n", S.solver, odhs_strerror(rc)), cli_usage(&cli, stderr);
             status = 2;
         } else {
             odhs_solver_destroy(s);
