@@ -67,14 +67,10 @@ static int stencil(int nc, int *off)
     return 1;
 }
 
-int odhs__pairs(int dim, size_t n, const double *x, const double *r, double rmax,
-                const double *L, double gamma, double max_gap, odhs_pair_fn fn, void *ctx)
+/* cell counts nc[] and widths w[]: cells at least rc (1 + |gamma|) wide in
+ * x' and rc in y, z, O(N) of them; returns the number of cells */
+static size_t cell_grid(int dim, size_t n, const double *L, double gamma, double rc, int *nc, double *w)
 {
-    if (n < 2) return ODHS_OK;
-    double rc = 2.0 * rmax + max_gap;
-    if (!(rc > 0.0)) rc = 1e-300;
-    int nc[3] = {1, 1, 1};
-    double w[3];
     double ext[3] = {rc * (1.0 + fabs(gamma)), rc, rc};
     for (int k = 0; k < dim; ++k) {
         double m = floor(L[k] / ext[k]);
@@ -89,17 +85,14 @@ int odhs__pairs(int dim, size_t n, const double *x, const double *r, double rmax
         total = (double)nc[0] * nc[1] * nc[2];
     }
     for (int k = 0; k < dim; ++k) w[k] = L[k] / nc[k];
-    size_t ncell = (size_t)nc[0] * nc[1] * nc[2];
+    return (size_t)nc[0] * nc[1] * nc[2];
+}
 
-    size_t *cell = odhs__malloc_array(n, sizeof *cell);
-    size_t *start = odhs__calloc(ncell + 1, sizeof *start);
-    size_t *order = odhs__malloc_array(n, sizeof *order);
-    if (!cell || !start || !order) {
-        odhs__free(cell);
-        odhs__free(start);
-        odhs__free(order);
-        return ODHS_E_NOMEM;
-    }
+/* counting sort of the particles by cell: cell c holds order[start[c]] to
+ * order[start[c + 1] - 1]; start[] comes zeroed */
+static int bin_particles(int dim, size_t n, const double *x, const double *L, double gamma, const int *nc,
+                         const double *w, size_t ncell, size_t *cell, size_t *start, size_t *order)
+{
     for (size_t i = 0; i < n; ++i) {
         const double *xi = x + i * dim;
         double xs = xi[0] - gamma * xi[1];
@@ -116,17 +109,32 @@ int odhs__pairs(int dim, size_t n, const double *x, const double *r, double rmax
         start[cell[i] + 1]++;
     }
     for (size_t c = 0; c < ncell; ++c) start[c + 1] += start[c];
-    {
-        size_t *fill = odhs__malloc_array(ncell, sizeof *fill);
-        if (!fill) {
-            odhs__free(cell);
-            odhs__free(start);
-            odhs__free(order);
-            return ODHS_E_NOMEM;
-        }
-        memcpy(fill, start, ncell * sizeof *fill);
-        for (size_t i = 0; i < n; ++i) order[fill[cell[i]]++] = i;
-        odhs__free(fill);
+    size_t *fill = odhs__malloc_array(ncell, sizeof *fill);
+    if (!fill) return ODHS_E_NOMEM;
+    memcpy(fill, start, ncell * sizeof *fill);
+    for (size_t i = 0; i < n; ++i) order[fill[cell[i]]++] = i;
+    odhs__free(fill);
+    return ODHS_OK;
+}
+
+int odhs__pairs(int dim, size_t n, const double *x, const double *r, double rmax,
+                const double *L, double gamma, double max_gap, odhs_pair_fn fn, void *ctx)
+{
+    if (n < 2) return ODHS_OK;
+    double rc = 2.0 * rmax + max_gap;
+    if (!(rc > 0.0)) rc = 1e-300;
+    int nc[3] = {1, 1, 1};
+    double w[3];
+    size_t ncell = cell_grid(dim, n, L, gamma, rc, nc, w);
+
+    size_t *cell = odhs__malloc_array(n, sizeof *cell);
+    size_t *start = odhs__calloc(ncell + 1, sizeof *start);
+    size_t *order = odhs__malloc_array(n, sizeof *order);
+    if (!cell || !start || !order || bin_particles(dim, n, x, L, gamma, nc, w, ncell, cell, start, order)) {
+        odhs__free(cell);
+        odhs__free(start);
+        odhs__free(order);
+        return ODHS_E_NOMEM;
     }
 
     int off[3][3], noff[3] = {1, 1, 1};

@@ -239,12 +239,64 @@ static int parse_flag(span t, int *flag)
     return -1;
 }
 
+/* Which of the columns species, pos and radius Properties has named. */
+typedef struct {
+    int sp, pos, rad;
+} props_seen;
+
+/* The count of the column name:type:count that starts at column *col; the
+ * columns species, pos and radius are checked and recorded in h. */
+static int parse_column(span name, span type, span f, size_t lineno, props_seen *have,
+                        size_t *col, header *h, char *msg)
+{
+    size_t count = 0;
+    int rc = parse_count(f, XYZ_COLS_MAX, &count);
+    if (rc != 0 || count == 0)
+        return odhs__err(msg, ODHS_E_FORMAT,
+                         "line %zu: Properties: column '%.*s' has invalid count '%.*s'",
+                         lineno, show_len(name), name.p, show_len(f), f.p);
+    if (count > XYZ_COLS_MAX - *col)
+        return odhs__err(msg, ODHS_E_FORMAT,
+                         "line %zu: Properties: too many columns", lineno);
+    char t = to_lower(type.p[0]);
+    if (span_ieq(name, "species")) {
+        if (have->sp)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: Properties: duplicate column 'species'", lineno);
+        if (t != 's' || count != 1)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: Properties: 'species' must be S:1", lineno);
+        have->sp = 1;
+        h->col_sp = *col;
+    } else if (span_ieq(name, "pos")) {
+        if (have->pos)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: Properties: duplicate column 'pos'", lineno);
+        if (t != 'r' || count != 3)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: Properties: 'pos' must be R:3", lineno);
+        have->pos = 1;
+        h->col_pos = *col;
+    } else if (span_ieq(name, "radius")) {
+        if (have->rad)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: Properties: duplicate column 'radius'", lineno);
+        if (t != 'r' || count != 1)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: Properties: 'radius' must be R:1", lineno);
+        have->rad = 1;
+        h->col_rad = *col;
+    }
+    *col += count;
+    return ODHS_OK;
+}
+
 /* Properties=name:type:count:... -> columns of species, pos, radius. */
 static int parse_properties(span v, size_t lineno, header *h, char *msg)
 {
     size_t i = 0, field = 0, col = 0;
     span name = {NULL, 0}, type = {NULL, 0};
-    int have_sp = 0, have_pos = 0, have_rad = 0;
+    props_seen have = {0, 0, 0};
     for (;;) {
         size_t start = i;
         while (i < v.n && v.p[i] != ':') i++;
@@ -267,45 +319,8 @@ static int parse_properties(span v, size_t lineno, header *h, char *msg)
             type = f;
             break;
         default: {
-            size_t count = 0;
-            int rc = parse_count(f, XYZ_COLS_MAX, &count);
-            if (rc != 0 || count == 0)
-                return odhs__err(msg, ODHS_E_FORMAT,
-                                 "line %zu: Properties: column '%.*s' has invalid count '%.*s'",
-                                 lineno, show_len(name), name.p, show_len(f), f.p);
-            if (count > XYZ_COLS_MAX - col)
-                return odhs__err(msg, ODHS_E_FORMAT,
-                                 "line %zu: Properties: too many columns", lineno);
-            char t = to_lower(type.p[0]);
-            if (span_ieq(name, "species")) {
-                if (have_sp)
-                    return odhs__err(msg, ODHS_E_FORMAT,
-                                     "line %zu: Properties: duplicate column 'species'", lineno);
-                if (t != 's' || count != 1)
-                    return odhs__err(msg, ODHS_E_FORMAT,
-                                     "line %zu: Properties: 'species' must be S:1", lineno);
-                have_sp = 1;
-                h->col_sp = col;
-            } else if (span_ieq(name, "pos")) {
-                if (have_pos)
-                    return odhs__err(msg, ODHS_E_FORMAT,
-                                     "line %zu: Properties: duplicate column 'pos'", lineno);
-                if (t != 'r' || count != 3)
-                    return odhs__err(msg, ODHS_E_FORMAT,
-                                     "line %zu: Properties: 'pos' must be R:3", lineno);
-                have_pos = 1;
-                h->col_pos = col;
-            } else if (span_ieq(name, "radius")) {
-                if (have_rad)
-                    return odhs__err(msg, ODHS_E_FORMAT,
-                                     "line %zu: Properties: duplicate column 'radius'", lineno);
-                if (t != 'r' || count != 1)
-                    return odhs__err(msg, ODHS_E_FORMAT,
-                                     "line %zu: Properties: 'radius' must be R:1", lineno);
-                have_rad = 1;
-                h->col_rad = col;
-            }
-            col += count;
+            int st = parse_column(name, type, f, lineno, &have, &col, h, msg);
+            if (st < 0) return st;
             break;
         }
         }
@@ -316,11 +331,11 @@ static int parse_properties(span v, size_t lineno, header *h, char *msg)
     if (field % 3 != 0)
         return odhs__err(msg, ODHS_E_FORMAT,
                          "line %zu: Properties: expected name:type:count triplets", lineno);
-    if (!have_sp || !have_pos || !have_rad)
+    if (!have.sp || !have.pos || !have.rad)
         return odhs__err(msg, ODHS_E_FORMAT,
                          "line %zu: Properties must contain species:S:1, pos:R:3 and "
                          "radius:R:1 (missing %s)",
-                         lineno, !have_sp ? "species" : !have_pos ? "pos" : "radius");
+                         lineno, !have.sp ? "species" : !have.pos ? "pos" : "radius");
     h->ncols = col;
     return ODHS_OK;
 }
@@ -328,13 +343,11 @@ static int parse_properties(span v, size_t lineno, header *h, char *msg)
 enum { K_LATTICE, K_PROPERTIES, K_PBC, K_DIM, K_STRAIN, K_COUNT };
 static const char *const key_names[K_COUNT] = {"Lattice", "Properties", "pbc", "dim", "strain"};
 
-static int parse_header(span line, size_t lineno, header *h, char *msg)
+/* Split the comment line into key[=value] items: the value of each known
+ * key in val[], have[] set for those present; other keys are ignored. */
+static int split_items(span line, size_t lineno, span *val, int *have, char *msg)
 {
-    span val[K_COUNT];
-    int have[K_COUNT] = {0};
     size_t i = 0;
-
-    /* 1. split into key[=value] items */
     for (;;) {
         while (i < line.n && is_ws(line.p[i])) i++;
         if (i >= line.n) break;
@@ -388,16 +401,12 @@ static int parse_header(span line, size_t lineno, header *h, char *msg)
         }
         /* any other key (with or without value) is ignored */
     }
+    return ODHS_OK;
+}
 
-    /* 2. interpret */
-    if (!have[K_LATTICE])
-        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: missing Lattice key", lineno);
-    if (!have[K_PROPERTIES])
-        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: missing Properties key", lineno);
-
-    int st = parse_properties(val[K_PROPERTIES], lineno, h, msg);
-    if (st < 0) return st;
-
+/* The dimension from the keys pbc and dim (3 without either). */
+static int parse_dim(const span *val, const int *have, size_t lineno, int *out, char *msg)
+{
     int dim = 3;
     if (have[K_PBC]) {
         int flags[3] = {1, 1, 1};
@@ -426,12 +435,17 @@ static int parse_header(span line, size_t lineno, header *h, char *msg)
             return odhs__err(msg, ODHS_E_FORMAT, "line %zu: dim must be 2 or 3, got '%.*s'",
                              lineno, show_len(d), d.p);
     }
-    h->dim = dim;
+    *out = dim;
+    return ODHS_OK;
+}
 
+/* Lattice: the box edges into h->L, the shear component b_x into *bx. */
+static int parse_lattice(span value, int dim, size_t lineno, header *h, double *bx_out, char *msg)
+{
     double lat[9];
     span bad = {NULL, 0};
     int nonfinite = 0;
-    long cnt = parse_number_list(val[K_LATTICE], lat, 9, &bad, &nonfinite);
+    long cnt = parse_number_list(value, lat, 9, &bad, &nonfinite);
     if (cnt < 0)
         return odhs__err(msg, ODHS_E_FORMAT, "line %zu: Lattice: %s '%.*s'", lineno,
                          nonfinite ? "non-finite number" : "invalid number", show_len(bad),
@@ -453,10 +467,18 @@ static int parse_header(span line, size_t lineno, header *h, char *msg)
     h->L[0] = Lx;
     h->L[1] = Ly;
     h->L[2] = dim == 3 ? Lz : 1.0;
+    *bx_out = bx;
+    return ODHS_OK;
+}
 
-    if (have[K_STRAIN]) {
+/* The strain: the key strain (NULL if absent), which must agree with the
+ * Lattice's bx = strain * Ly, else bx / Ly. */
+static int parse_strain(const span *value, double bx, double Ly, size_t lineno, header *h,
+                        char *msg)
+{
+    if (value) {
         double g = 0.0;
-        span s = trim(val[K_STRAIN]);
+        span s = trim(*value);
         int rc = parse_double(s, &g);
         if (rc != 0)
             return odhs__err(msg, ODHS_E_FORMAT, "line %zu: strain: %s '%.*s'", lineno,
@@ -474,6 +496,35 @@ static int parse_header(span line, size_t lineno, header *h, char *msg)
                              lineno);
     }
     return ODHS_OK;
+}
+
+static int parse_header(span line, size_t lineno, header *h, char *msg)
+{
+    span val[K_COUNT];
+    int have[K_COUNT] = {0};
+
+    /* 1. split into key[=value] items */
+    int st = split_items(line, lineno, val, have, msg);
+    if (st < 0) return st;
+
+    /* 2. interpret */
+    if (!have[K_LATTICE])
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: missing Lattice key", lineno);
+    if (!have[K_PROPERTIES])
+        return odhs__err(msg, ODHS_E_FORMAT, "line %zu: missing Properties key", lineno);
+
+    st = parse_properties(val[K_PROPERTIES], lineno, h, msg);
+    if (st < 0) return st;
+
+    int dim = 3;
+    st = parse_dim(val, have, lineno, &dim, msg);
+    if (st < 0) return st;
+    h->dim = dim;
+
+    double bx = 0.0;
+    st = parse_lattice(val[K_LATTICE], dim, lineno, h, &bx, msg);
+    if (st < 0) return st;
+    return parse_strain(have[K_STRAIN] ? &val[K_STRAIN] : NULL, bx, h->L[1], lineno, h, msg);
 }
 
 /* ---- particle lines --------------------------------------------------------- */
@@ -536,13 +587,11 @@ static int is_blank(span line)
     return trim(line).n == 0;
 }
 
-static int parse_impl(const char *buf, size_t len, odhs_system **out, char *msg)
+/* Line 1: the number of particles. */
+static int parse_count_line(reader *rd, size_t *out, char *msg)
 {
-    reader rd = {buf, len, 0, 0};
     span line;
-
-    /* line 1: N */
-    if (!next_line(&rd, &line))
+    if (!next_line(rd, &line))
         return odhs__err(msg, ODHS_E_FORMAT, "line 1: empty file");
     span t = trim(line);
     size_t n = 0;
@@ -555,70 +604,52 @@ static int parse_impl(const char *buf, size_t len, odhs_system **out, char *msg)
                          "line 1: expected the number of particles (a positive integer), "
                          "found '%.*s'",
                          show_len(t), t.p);
+    *out = n;
+    return ODHS_OK;
+}
 
-    /* line 2: key=value pairs */
-    if (!next_line(&rd, &line))
-        return odhs__err(msg, ODHS_E_FORMAT, "line 2: file ends before the comment line");
-    header h;
-    memset(&h, 0, sizeof h);
-    int st = parse_header(line, rd.lineno, &h, msg);
-    if (st < 0) return st;
-
-    /* pass 1: make sure the N lines exist before allocating anything */
-    reader body = rd;
+/* The n particle lines (known to exist) into x, r and sp, then what follows
+ * them: first frame only, so skip blank lines, accept (and ignore) a
+ * following frame, reject anything else (usually a wrong N). */
+static int parse_body(reader *rd, size_t n, const header *h, double *x, double *r,
+                      char (*sp)[ODHS_SPECIES_MAX + 1], char *msg)
+{
+    span line;
+    int dim = h->dim;
     for (size_t i = 0; i < n; i++) {
-        if (!next_line(&rd, &line))
-            return odhs__err(msg, ODHS_E_FORMAT,
-                             "line %zu: file ends after %zu of %zu particle lines", rd.lineno + 1,
-                             i, n);
+        if (!next_line(rd, &line)) /* cannot happen after pass 1 */
+            return odhs__err(msg, ODHS_E_INTERNAL, "line %zu: unexpected end of input",
+                             rd->lineno + 1);
+        int st = parse_particle(line, rd->lineno, h, &x[i * (size_t)dim], &r[i], sp[i], msg);
+        if (st < 0) return st;
     }
-
-    /* pass 2: parse into temporary arrays */
-    int dim = h.dim;
-    double *x = odhs__malloc_array(n, (size_t)dim * sizeof(double));
-    double *r = odhs__malloc_array(n, sizeof(double));
-    char(*sp)[ODHS_SPECIES_MAX + 1] = odhs__malloc_array(n, sizeof *sp);
-    odhs_system *sys = NULL;
-    if (!x || !r || !sp) {
-        st = odhs__err(msg, ODHS_E_NOMEM, "out of memory reading %zu particles", n);
-        goto done;
-    }
-    rd = body;
-    for (size_t i = 0; i < n; i++) {
-        if (!next_line(&rd, &line)) { /* cannot happen after pass 1 */
-            st = odhs__err(msg, ODHS_E_INTERNAL, "line %zu: unexpected end of input",
-                           rd.lineno + 1);
-            goto done;
-        }
-        st = parse_particle(line, rd.lineno, &h, &x[i * (size_t)dim], &r[i], sp[i], msg);
-        if (st < 0) goto done;
-    }
-    /* first frame only: skip blank lines, accept (and ignore) a following
-     * frame, reject anything else (usually a wrong N) */
-    while (next_line(&rd, &line)) {
+    while (next_line(rd, &line)) {
         if (is_blank(line)) continue;
-        if (!is_frame_start(line)) {
-            st = odhs__err(msg, ODHS_E_FORMAT,
-                           "line %zu: unexpected content after %zu particle lines "
-                           "(is the particle count on line 1 right?)",
-                           rd.lineno, n);
-            goto done;
-        }
+        if (!is_frame_start(line))
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: unexpected content after %zu particle lines "
+                             "(is the particle count on line 1 right?)",
+                             rd->lineno, n);
         break;
     }
+    return ODHS_OK;
+}
 
-    /* build and validate the system */
-    st = odhs_system_create(dim, n, &sys);
+/* Build and validate the system; *out is set only on success. */
+static int build_system(size_t n, const header *h, const double *x, const double *r,
+                        char (*sp)[ODHS_SPECIES_MAX + 1], odhs_system **out, char *msg)
+{
+    odhs_system *sys = NULL;
+    int st = odhs_system_create(h->dim, n, &sys);
     if (st < 0) {
-        sys = NULL;
         odhs__err(msg, st, "cannot create system: %s", odhs_strerror(st));
-        goto done;
+        return st;
     }
     /* a state written between two drift corrections holds contacts whose
      * gaps drift (up to ~1e-4 of the contact distance with the paper's
      * Euler steps): read such files back; real overlaps are still refused */
     sys->overlap_accept = ODHS_XYZ_OVERLAP_ACCEPT;
-    st = odhs_system_set_configuration(sys, h.L, h.gamma, r, x);
+    st = odhs_system_set_configuration(sys, h->L, h->gamma, r, x);
     sys->overlap_accept = 0.0;
     if (st < 0) {
         odhs__err(msg, st, "file: %s", odhs_system_errmsg(sys));
@@ -639,6 +670,51 @@ static int parse_impl(const char *buf, size_t len, odhs_system **out, char *msg)
 
 done:
     odhs_system_destroy(sys);
+    return st;
+}
+
+static int parse_impl(const char *buf, size_t len, odhs_system **out, char *msg)
+{
+    reader rd = {buf, len, 0, 0};
+    span line;
+
+    /* line 1: N */
+    size_t n = 0;
+    int st = parse_count_line(&rd, &n, msg);
+    if (st < 0) return st;
+
+    /* line 2: key=value pairs */
+    if (!next_line(&rd, &line))
+        return odhs__err(msg, ODHS_E_FORMAT, "line 2: file ends before the comment line");
+    header h;
+    memset(&h, 0, sizeof h);
+    st = parse_header(line, rd.lineno, &h, msg);
+    if (st < 0) return st;
+
+    /* pass 1: make sure the N lines exist before allocating anything */
+    reader body = rd;
+    for (size_t i = 0; i < n; i++) {
+        if (!next_line(&rd, &line))
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: file ends after %zu of %zu particle lines", rd.lineno + 1,
+                             i, n);
+    }
+
+    /* pass 2: parse into temporary arrays, then build the system */
+    int dim = h.dim;
+    double *x = odhs__malloc_array(n, (size_t)dim * sizeof(double));
+    double *r = odhs__malloc_array(n, sizeof(double));
+    char(*sp)[ODHS_SPECIES_MAX + 1] = odhs__malloc_array(n, sizeof *sp);
+    if (!x || !r || !sp) {
+        st = odhs__err(msg, ODHS_E_NOMEM, "out of memory reading %zu particles", n);
+        goto done;
+    }
+    rd = body;
+    st = parse_body(&rd, n, &h, x, r, sp, msg);
+    if (st < 0) goto done;
+    st = build_system(n, &h, x, r, sp, out, msg);
+
+done:
     odhs__free(x);
     odhs__free(r);
     odhs__free(sp);

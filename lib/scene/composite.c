@@ -171,14 +171,13 @@ static double independence(const odhs_system *s, size_t p, const size_t *a, int 
 
 #define INDEP_MIN 1e-3 /* smallest |sin| / |det| accepted between bond directions */
 
-int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
+/* the beads of a new rigid body: valid, distinct, in no other body and at
+ * distinct positions */
+static int check_body_beads(const odhs_stepper *st, size_t k, const size_t *beads)
 {
-    if (!st) return ODHS_E_NULL;
-    if (!beads) return cerr(st, ODHS_E_NULL, "beads pointer is NULL");
-    if (k < 2) return cerr(st, ODHS_E_INVALID, "a rigid body needs at least 2 beads (got %zu)", k);
-    odhs_network *net = st->net;
+    const odhs_network *net = st->net;
     const odhs_system *sys = st->sys;
-    int dim = st->dim, s;
+    int s;
     for (size_t a = 0; a < k; ++a) {
         if ((s = check_index(st, beads[a]))) return s;
         for (size_t b = 0; b < a; ++b)
@@ -186,77 +185,93 @@ int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
         if (net->rbody && net->rbody[beads[a]] != SIZE_MAX)
             return cerr(st, ODHS_E_INVALID, "bead %zu already belongs to a rigid body", beads[a]);
     }
-    double hb = half_box(sys), d[3];
+    double d[3];
     for (size_t a = 0; a < k; ++a)
         for (size_t b = 0; b < a; ++b) {
             double r = separation(sys, beads[a], beads[b], d);
             if (!(r > 0.0)) return cerr(st, ODHS_E_INVALID, "beads %zu and %zu coincide", beads[a], beads[b]);
         }
-    /* plan the bonds: order[] grows by the bead with the best-conditioned
-     * anchors among the nearest placed beads */
-    size_t *order = odhs__malloc_array(k, sizeof *order);
-    size_t nbmax = k * (size_t)dim;
-    size_t *bi = odhs__malloc_array(nbmax, sizeof *bi), *bj = odhs__malloc_array(nbmax, sizeof *bj);
-    bond_rec *rec = odhs__malloc_array(nbmax, sizeof *rec);
-    unsigned char *placed = odhs__calloc(k, 1);
-    if (!order || !bi || !bj || !rec || !placed) {
-        s = cerr(st, ODHS_E_NOMEM, "out of memory");
-        goto done;
+    return ODHS_OK;
+}
+
+/* the `need` nearest placed beads (order[0..nplaced-1]) with independent
+ * directions from bead p, chosen greedily by distance, into anc[]; returns
+ * how many were found */
+static int find_anchors(const odhs_system *sys, const size_t *beads, size_t p, const size_t *order,
+                        size_t nplaced, int need, size_t *anc)
+{
+    double d[3];
+    int na = 0;
+    for (int round = 0; round < need; ++round) {
+        double dbest = INFINITY;
+        size_t qb = SIZE_MAX;
+        for (size_t q = 0; q < nplaced; ++q) {
+            size_t b = beads[order[q]];
+            int skip = 0;
+            for (int t = 0; t < na; ++t) skip |= anc[t] == b;
+            if (skip) continue;
+            anc[na] = b;
+            if (independence(sys, beads[p], anc, na + 1) < INDEP_MIN) continue;
+            double r = separation(sys, beads[p], b, d);
+            if (r < dbest) {
+                dbest = r;
+                qb = q;
+            }
+        }
+        if (qb == SIZE_MAX) break;
+        anc[na++] = beads[order[qb]];
     }
+    return na;
+}
+
+/* the unplaced bead whose `need` anchors are best conditioned, its anchors
+ * in besta[]; SIZE_MAX if no bead has enough independent anchors */
+static size_t next_bead(const odhs_system *sys, size_t k, const size_t *beads, const size_t *order, size_t nplaced,
+                        const unsigned char *placed, int need, size_t *besta)
+{
+    double best = -1.0;
+    size_t bestp = SIZE_MAX;
+    for (size_t p = 0; p < k; ++p) {
+        if (placed[p]) continue;
+        size_t anc[3];
+        int na = find_anchors(sys, beads, p, order, nplaced, need, anc);
+        if (na < need) continue;
+        double ind = independence(sys, beads[p], anc, na);
+        if (ind > best) {
+            best = ind;
+            bestp = p;
+            memcpy(besta, anc, sizeof anc);
+        }
+    }
+    return bestp;
+}
+
+/* plan the bonds: order[] grows by the bead with the best-conditioned
+ * anchors among the nearest placed beads; the new bonds go to bi[], bj[] */
+static int plan_bonds(const odhs_stepper *st, size_t k, const size_t *beads, size_t *order, unsigned char *placed,
+                      size_t *bi, size_t *bj, size_t *nb_out)
+{
+    const odhs_network *net = st->net;
+    const odhs_system *sys = st->sys;
+    int dim = st->dim;
+    double hb = half_box(sys), d[3];
     size_t nplaced = 0, nb = 0;
     order[nplaced++] = 0;
     placed[0] = 1;
     while (nplaced < k) {
         int need = (int)(nplaced < (size_t)dim ? nplaced : (size_t)dim);
-        double best = -1.0;
-        size_t bestp = SIZE_MAX, besta[3] = {0, 0, 0};
-        for (size_t p = 0; p < k; ++p) {
-            if (placed[p]) continue;
-            /* the `need` nearest placed beads with independent directions,
-             * chosen greedily by distance */
-            size_t anc[3];
-            int na = 0;
-            for (int round = 0; round < need; ++round) {
-                double dbest = INFINITY;
-                size_t qb = SIZE_MAX;
-                for (size_t q = 0; q < nplaced; ++q) {
-                    size_t b = beads[order[q]];
-                    int skip = 0;
-                    for (int t = 0; t < na; ++t) skip |= anc[t] == b;
-                    if (skip) continue;
-                    anc[na] = b;
-                    if (independence(sys, beads[p], anc, na + 1) < INDEP_MIN) continue;
-                    double r = separation(sys, beads[p], b, d);
-                    if (r < dbest) {
-                        dbest = r;
-                        qb = q;
-                    }
-                }
-                if (qb == SIZE_MAX) break;
-                anc[na++] = beads[order[qb]];
-            }
-            if (na < need) continue;
-            double ind = independence(sys, beads[p], anc, na);
-            if (ind > best) {
-                best = ind;
-                bestp = p;
-                memcpy(besta, anc, sizeof anc);
-            }
-        }
-        if (bestp == SIZE_MAX) {
-            s = cerr(st, ODHS_E_INVALID,
-                     "the beads are (nearly) %s: distance constraints cannot make them a rigid body "
-                     "(use a chain, or beads off one %s)",
-                     dim == 2 ? "collinear" : "coplanar or collinear", dim == 2 ? "line" : "plane");
-            goto done;
-        }
+        size_t besta[3] = {0, 0, 0};
+        size_t bestp = next_bead(sys, k, beads, order, nplaced, placed, need, besta);
+        if (bestp == SIZE_MAX)
+            return cerr(st, ODHS_E_INVALID,
+                        "the beads are (nearly) %s: distance constraints cannot make them a rigid body "
+                        "(use a chain, or beads off one %s)",
+                        dim == 2 ? "collinear" : "coplanar or collinear", dim == 2 ? "line" : "plane");
         for (int t = 0; t < need; ++t) {
             double r = separation(sys, beads[bestp], besta[t], d);
-            if (r >= hb) {
-                s = cerr(st, ODHS_E_INVALID, "beads %zu and %zu are %g apart: not below half the box edge",
-                         beads[bestp], besta[t], r);
-                goto done;
-            }
+            if (r >= hb)
+                return cerr(st, ODHS_E_INVALID, "beads %zu and %zu are %g apart: not below half the box edge",
+                            beads[bestp], besta[t], r);
             size_t c = odhs__net_find(net, beads[bestp], besta[t]);
             if (c != SIZE_MAX && net->kind[c] == ODHS_CONTACT_PERMANENT)
                 continue; /* already bonded (e.g. by an earlier chain) */
@@ -266,6 +281,50 @@ int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
         placed[bestp] = 1;
         order[nplaced++] = bestp;
     }
+    *nb_out = nb;
+    return ODHS_OK;
+}
+
+/* the bonds bi[b]-bj[b] at their current lengths, all or none */
+static int make_body_bonds(odhs_stepper *st, const size_t *bi, const size_t *bj, size_t nb, bond_rec *rec)
+{
+    odhs_network *net = st->net;
+    const odhs_system *sys = st->sys;
+    double d[3];
+    int s;
+    size_t m = 0;
+    for (size_t b = 0; b < nb; ++b) {
+        double r = separation(sys, bi[b], bj[b], d);
+        if ((s = make_bond(net, bi[b], bj[b], r, &rec[m]))) {
+            undo_bonds(net, rec, m);
+            return cerr(st, s, "%s", net->errmsg);
+        }
+        net->dist[odhs__net_find(net, bi[b], bj[b])] = r;
+        m++;
+    }
+    return ODHS_OK;
+}
+
+int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!beads) return cerr(st, ODHS_E_NULL, "beads pointer is NULL");
+    if (k < 2) return cerr(st, ODHS_E_INVALID, "a rigid body needs at least 2 beads (got %zu)", k);
+    odhs_network *net = st->net;
+    int dim = st->dim;
+    int s = check_body_beads(st, k, beads);
+    if (s) return s;
+    size_t *order = odhs__malloc_array(k, sizeof *order);
+    size_t nbmax = k * (size_t)dim;
+    size_t *bi = odhs__malloc_array(nbmax, sizeof *bi), *bj = odhs__malloc_array(nbmax, sizeof *bj);
+    bond_rec *rec = odhs__malloc_array(nbmax, sizeof *rec);
+    unsigned char *placed = odhs__calloc(k, 1);
+    if (!order || !bi || !bj || !rec || !placed) {
+        s = cerr(st, ODHS_E_NOMEM, "out of memory");
+        goto done;
+    }
+    size_t nb = 0;
+    if ((s = plan_bonds(st, k, beads, order, placed, bi, bj, &nb))) goto done;
     if (!net->rbody) {
         net->rbody = odhs__malloc_array(st->n, sizeof *net->rbody);
         if (!net->rbody) {
@@ -274,17 +333,7 @@ int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
         }
         for (size_t i = 0; i < st->n; ++i) net->rbody[i] = SIZE_MAX;
     }
-    size_t m = 0;
-    for (size_t b = 0; b < nb; ++b) {
-        double r = separation(sys, bi[b], bj[b], d);
-        if ((s = make_bond(net, bi[b], bj[b], r, &rec[m]))) {
-            undo_bonds(net, rec, m);
-            s = cerr(st, s, "%s", net->errmsg);
-            goto done;
-        }
-        net->dist[odhs__net_find(net, bi[b], bj[b])] = r;
-        m++;
-    }
+    if ((s = make_body_bonds(st, bi, bj, nb, rec))) goto done;
     /* label: the smallest bead index; other contacts inside the body go */
     size_t label = beads[0];
     for (size_t a = 1; a < k; ++a) label = beads[a] < label ? beads[a] : label;

@@ -153,33 +153,38 @@ static uint64_t net_checksum(const odhs_network *net)
     return h ^ net->nc;
 }
 
-/* The one solve path: b given (N x = b), or g given (least squares on S^T,
- * b = S g). Sets up the backend when needed and checks the result. */
-static int solve_one(odhs_solver *s, const odhs_network *net, const double *b, const double *g, double *x,
-                     int reuse)
+/* the work space holds at least need doubles */
+static int reserve_work(odhs_solver *s, size_t need)
 {
-    if (!s) return ODHS_E_NULL;
-    if (!net) return solerr(s, ODHS_E_NULL, "network is NULL");
-    size_t nc = net->nc, nd = net->n * (size_t)net->dim;
-    if (nc == 0) return ODHS_OK;
-    if ((!b && !g) || !x) return solerr(s, ODHS_E_NULL, "vector pointer is NULL");
-    size_t need = 2 * nc + nd;
     if (s->work_cap < need) {
         double *w = odhs__realloc(s->work, need * sizeof *w);
         if (!w) return solerr(s, ODHS_E_NOMEM, "out of memory");
         s->work = w;
         s->work_cap = need;
     }
-    double *Nx = s->work, *tmp = s->work + nc, *bg = s->work + nc + nd;
+    return ODHS_OK;
+}
+
+/* the right-hand side must be finite; given g, *b becomes bg = S g */
+static int check_rhs(odhs_solver *s, const odhs_network *net, const double *g, const double **b, double *bg)
+{
+    size_t nc = net->nc, nd = net->n * (size_t)net->dim;
     if (g) {
         for (size_t k = 0; k < nd; ++k)
             if (!isfinite(g[k])) return solerr(s, ODHS_E_NONFINITE, "right-hand side entry %zu is not finite", k);
         odhs__net_S(net, g, bg);
-        b = bg;
+        *b = bg;
     } else {
         for (size_t c = 0; c < nc; ++c)
-            if (!isfinite(b[c])) return solerr(s, ODHS_E_NONFINITE, "right-hand side entry %zu is not finite", c);
+            if (!isfinite((*b)[c])) return solerr(s, ODHS_E_NONFINITE, "right-hand side entry %zu is not finite", c);
     }
+    return ODHS_OK;
+}
+
+/* set the backend up for net unless it already is (same network, version
+ * and, without reuse, the same contact pattern and geometry) */
+static int setup_backend(odhs_solver *s, const odhs_network *net, int reuse)
+{
     int st;
     uint64_t sum = (reuse || !s->type->setup) ? 0 : net_checksum(net);
     if (s->type->setup && (!s->have_setup || s->last_net != net || s->last_version != net->version ||
@@ -195,6 +200,13 @@ static int solve_one(odhs_solver *s, const odhs_network *net, const double *b, c
         s->last_version = net->version;
         s->last_sum = sum;
     }
+    return ODHS_OK;
+}
+
+/* the starting point: x itself for backends that use a guess, unless it
+ * is not finite; zero otherwise */
+static void start_guess(const odhs_solver *s, double *x, size_t nc)
+{
     if (!(s->type->flags & ODHS_SOLVER_USES_GUESS)) memset(x, 0, nc * sizeof *x);
     else
         for (size_t c = 0; c < nc; ++c)
@@ -202,6 +214,75 @@ static int solve_one(odhs_solver *s, const odhs_network *net, const double *b, c
                 memset(x, 0, nc * sizeof *x);
                 break;
             }
+}
+
+/* iterative refinement for direct backends on ill-conditioned networks
+ * (close to jamming): x += N^-1 (b - N x), a few times at most; Nx = N x
+ * on entry and on return */
+static int refine_solution(odhs_solver *s, const odhs_network *net, const double *b, double *x, double *Nx,
+                           double *tmp, double bn)
+{
+    size_t nc = net->nc;
+    double *r = odhs__malloc_array(2 * nc, sizeof *r);
+    if (!r) return solerr(s, ODHS_E_NOMEM, "%s: out of memory for iterative refinement", s->type->name);
+    for (int pass = 0; pass < s->refine && s->last_residual > 1e-14; ++pass) {
+        double *dx = r + nc;
+        for (size_t c = 0; c < nc; ++c) r[c] = b[c] - Nx[c];
+        memset(dx, 0, nc * sizeof *dx);
+        if (s->type->solve(s->state, net, r, dx) != ODHS_OK) break;
+        for (size_t c = 0; c < nc; ++c) dx[c] += x[c];
+        odhs__net_N(net, dx, Nx, tmp);
+        double rn2 = 0.0;
+        for (size_t c = 0; c < nc; ++c) rn2 += (Nx[c] - b[c]) * (Nx[c] - b[c]);
+        double res2 = bn > 0.0 ? sqrt(rn2 / bn) : sqrt(rn2);
+        if (!(res2 < s->last_residual)) {
+            odhs__net_N(net, x, Nx, tmp); /* keep the better x */
+            break;
+        }
+        memcpy(x, dx, nc * sizeof *x);
+        s->last_residual = res2;
+    }
+    odhs__free(r);
+    return ODHS_OK;
+}
+
+/* accept on the normwise backward error |r| / (|N| |x| + |b|): close to
+ * jamming cond(N) is huge and even an exact-arithmetic-quality solution
+ * has a relative residual of order eps cond(N); |N|_2 <= 2 max degree */
+static int check_backward(odhs_solver *s, const odhs_network *net, const double *x, double bn)
+{
+    size_t nc = net->nc;
+    size_t maxdeg = 1;
+    for (size_t i = 0; i < net->n; ++i) maxdeg = net->adjn[i] > maxdeg ? net->adjn[i] : maxdeg;
+    double xn = 0.0;
+    for (size_t c = 0; c < nc; ++c) xn += x[c] * x[c];
+    double rnorm = s->last_residual * (bn > 0.0 ? sqrt(bn) : 1.0);
+    double den = 2.0 * (double)maxdeg * sqrt(xn) + sqrt(bn);
+    s->last_backward = den > 0.0 ? rnorm / den : rnorm;
+    if (s->last_backward > s->check_tol) {
+        int code = (s->type->flags & ODHS_SOLVER_ITERATIVE) ? ODHS_E_NOCONV : ODHS_E_SINGULAR;
+        return solerr(s, code, "%s: backward error %.3g above %.3g (relative residual %.3g)", s->type->name,
+                      s->last_backward, s->check_tol, s->last_residual);
+    }
+    return ODHS_OK;
+}
+
+/* The one solve path: b given (N x = b), or g given (least squares on S^T,
+ * b = S g). Sets up the backend when needed and checks the result. */
+static int solve_one(odhs_solver *s, const odhs_network *net, const double *b, const double *g, double *x,
+                     int reuse)
+{
+    if (!s) return ODHS_E_NULL;
+    if (!net) return solerr(s, ODHS_E_NULL, "network is NULL");
+    size_t nc = net->nc, nd = net->n * (size_t)net->dim;
+    if (nc == 0) return ODHS_OK;
+    if ((!b && !g) || !x) return solerr(s, ODHS_E_NULL, "vector pointer is NULL");
+    int st = reserve_work(s, 2 * nc + nd);
+    if (st) return st;
+    double *Nx = s->work, *tmp = s->work + nc, *bg = s->work + nc + nd;
+    if ((st = check_rhs(s, net, g, &b, bg))) return st;
+    if ((st = setup_backend(s, net, reuse))) return st;
+    start_guess(s, x, nc);
     if (g && s->type->version >= 2 && s->type->solve_ls) st = s->type->solve_ls(s->state, net, g, x);
     else st = s->type->solve(s->state, net, b, x);
     s->nsolves += 1.0;
@@ -220,49 +301,14 @@ static int solve_one(odhs_solver *s, const odhs_network *net, const double *b, c
         bn += b[c] * b[c];
     }
     s->last_residual = bn > 0.0 ? sqrt(rn / bn) : sqrt(rn);
-    /* iterative refinement for direct backends on ill-conditioned networks
-     * (close to jamming): x += N^-1 (b - N x), a few times at most */
     if (st == ODHS_OK && s->refine > 0 && !(s->type->flags & ODHS_SOLVER_ITERATIVE)) {
-        double *r = odhs__malloc_array(2 * nc, sizeof *r);
-        if (!r) return solerr(s, ODHS_E_NOMEM, "%s: out of memory for iterative refinement", s->type->name);
-        for (int pass = 0; pass < s->refine && s->last_residual > 1e-14; ++pass) {
-            double *dx = r + nc;
-            for (size_t c = 0; c < nc; ++c) r[c] = b[c] - Nx[c];
-            memset(dx, 0, nc * sizeof *dx);
-            if (s->type->solve(s->state, net, r, dx) != ODHS_OK) break;
-            for (size_t c = 0; c < nc; ++c) dx[c] += x[c];
-            odhs__net_N(net, dx, Nx, tmp);
-            double rn2 = 0.0;
-            for (size_t c = 0; c < nc; ++c) rn2 += (Nx[c] - b[c]) * (Nx[c] - b[c]);
-            double res2 = bn > 0.0 ? sqrt(rn2 / bn) : sqrt(rn2);
-            if (!(res2 < s->last_residual)) {
-                odhs__net_N(net, x, Nx, tmp); /* keep the better x */
-                break;
-            }
-            memcpy(x, dx, nc * sizeof *x);
-            s->last_residual = res2;
-        }
-        odhs__free(r);
+        int rs = refine_solution(s, net, b, x, Nx, tmp, bn);
+        if (rs) return rs;
     }
     if (st < 0)
         return solerr(s, st, "%s: solve failed (%s), relative residual %.3g", s->type->name, odhs_strerror(st),
                       s->last_residual);
-    /* accept on the normwise backward error |r| / (|N| |x| + |b|): close to
-     * jamming cond(N) is huge and even an exact-arithmetic-quality solution
-     * has a relative residual of order eps cond(N); |N|_2 <= 2 max degree */
-    size_t maxdeg = 1;
-    for (size_t i = 0; i < net->n; ++i) maxdeg = net->adjn[i] > maxdeg ? net->adjn[i] : maxdeg;
-    double xn = 0.0;
-    for (size_t c = 0; c < nc; ++c) xn += x[c] * x[c];
-    double rnorm = s->last_residual * (bn > 0.0 ? sqrt(bn) : 1.0);
-    double den = 2.0 * (double)maxdeg * sqrt(xn) + sqrt(bn);
-    s->last_backward = den > 0.0 ? rnorm / den : rnorm;
-    if (s->last_backward > s->check_tol) {
-        int code = (s->type->flags & ODHS_SOLVER_ITERATIVE) ? ODHS_E_NOCONV : ODHS_E_SINGULAR;
-        return solerr(s, code, "%s: backward error %.3g above %.3g (relative residual %.3g)", s->type->name,
-                      s->last_backward, s->check_tol, s->last_residual);
-    }
-    return ODHS_OK;
+    return check_backward(s, net, x, bn);
 }
 
 /* ---- fallback (odhs_solver_set_fallback) ------------------------------------ */

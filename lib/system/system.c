@@ -451,6 +451,7 @@ typedef struct {
     int dim, nc[3];
     double w[3];
     size_t *head, *next; /* linked lists, SIZE_MAX terminates */
+    int noff[3], off[3][5]; /* neighbour cells to visit in each direction */
 } rsa_grid;
 
 static size_t rsa_cell(const rsa_grid *g, const double *x)
@@ -487,6 +488,117 @@ static void sort_by_radius(size_t *idx, size_t *tmp, size_t n, const double *r)
     memcpy(idx, tmp, n * sizeof *idx);
 }
 
+/* cell counts and widths of the grid over the box L: cells at least
+ * 2 rmax wide, O(n) of them; returns the number of cells */
+static size_t rsa_grid_size(rsa_grid *g, const double *L, double rmax, size_t n)
+{
+    int dim = g->dim;
+    double cw = 2.0 * rmax;
+    size_t ncell = 1;
+    for (int k = 0; k < dim; ++k) {
+        double m = floor(L[k] / cw);
+        if (m > 4096) m = 4096;
+        g->nc[k] = m < 1 ? 1 : (int)m;
+    }
+    while ((double)g->nc[0] * g->nc[1] * g->nc[2] > 4.0 * (double)n + 64)
+        for (int k = 0; k < dim; ++k) g->nc[k] = g->nc[k] > 1 ? (g->nc[k] + 1) / 2 : 1;
+    for (int k = 0; k < dim; ++k) {
+        g->w[k] = L[k] / g->nc[k];
+        ncell *= (size_t)g->nc[k];
+    }
+    return ncell;
+}
+
+/* the cell offsets to visit around a cell, in each direction */
+static void rsa_stencil(rsa_grid *g)
+{
+    for (int k = 0; k < 3; ++k) {
+        g->noff[k] = 1;
+        g->off[k][0] = 0;
+    }
+    for (int k = 0; k < g->dim; ++k) {
+        /* a placed particle can reach one cell away when w >= 2 rmax; coarse
+         * grids (few cells) visit every cell once */
+        if (g->nc[k] >= 3) {
+            g->noff[k] = 3;
+            g->off[k][0] = -1; g->off[k][1] = 0; g->off[k][2] = 1;
+        } else {
+            g->noff[k] = g->nc[k];
+            for (int m = 0; m < g->nc[k]; ++m) g->off[k][m] = m;
+        }
+    }
+}
+
+/* whether particle i, at its trial position in x, overlaps none of the
+ * particles already in the grid */
+static int rsa_fits(const rsa_grid *g, const double *L, const double *r, const double *x, size_t i)
+{
+    int dim = g->dim;
+    const double *xi = x + i * dim;
+    int ok = 1;
+    int c0[3] = {0, 0, 0};
+    for (int k = 0; k < dim; ++k) {
+        c0[k] = (int)floor(xi[k] / g->w[k]);
+        if (c0[k] >= g->nc[k]) c0[k] = g->nc[k] - 1;
+    }
+    for (int a = 0; a < g->noff[2] && ok; ++a)
+        for (int b = 0; b < g->noff[1] && ok; ++b)
+            for (int e = 0; e < g->noff[0] && ok; ++e) {
+                int cc[3] = {c0[0] + g->off[0][e], c0[1] + g->off[1][b], c0[2] + g->off[2][a]};
+                size_t c = 0;
+                for (int k = dim - 1; k >= 0; --k) {
+                    int ck = ((cc[k] % g->nc[k]) + g->nc[k]) % g->nc[k];
+                    if (g->nc[k] < 3) ck = cc[k] - c0[k]; /* absolute cell index */
+                    c = c * (size_t)g->nc[k] + (size_t)ck;
+                }
+                for (size_t j = g->head[c]; j != SIZE_MAX; j = g->next[j]) {
+                    double d[3] = {0, 0, 0};
+                    for (int k = 0; k < dim; ++k) d[k] = x[j * dim + k] - xi[k];
+                    odhs__min_image(dim, L, 0.0, d, NULL);
+                    double s2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    double dd = r[i] + r[j];
+                    if (s2 < dd * dd) {
+                        ok = 0;
+                        break;
+                    }
+                }
+            }
+    return ok;
+}
+
+/* random sequential addition into the box L, in the order idx, each
+ * particle at the first of up to max_tries uniform positions that fits */
+static int rsa_place(odhs_system *sys, rsa_grid *g, const double *L, const size_t *idx, double *x, double phi,
+                     uint64_t seed)
+{
+    int dim = sys->dim;
+    size_t n = sys->n;
+    odhs_rng rng;
+    odhs__rng_seed(&rng, seed);
+    const uint64_t max_tries = 2000000; /* per particle */
+    for (size_t p = 0; p < n; ++p) {
+        size_t i = idx[p];
+        double *xi = x + i * dim;
+        uint64_t t;
+        for (t = 0; t < max_tries; ++t) {
+            for (int k = 0; k < dim; ++k) xi[k] = odhs__rng_uniform(&rng) * L[k];
+            if (rsa_fits(g, L, sys->r, x, i)) break;
+        }
+        if (t == max_tries) {
+            double vdone = 0.0, vol = L[0] * L[1] * (dim == 3 ? L[2] : 1.0);
+            for (size_t q = 0; q < p; ++q) vdone += particle_volume(dim, sys->r[idx[q]]);
+            return odhs__syserr(sys, ODHS_E_TOODENSE,
+                                "random sequential addition stalled after placing %zu of %zu particles "
+                                "(phi = %.4f of the requested %.4f)",
+                                p, n, vdone / vol, phi);
+        }
+        size_t c = rsa_cell(g, xi);
+        g->next[i] = g->head[c];
+        g->head[c] = i;
+    }
+    return ODHS_OK;
+}
+
 int odhs_system_place_random(odhs_system *sys, double phi, uint64_t seed)
 {
     if (!sys) return ODHS_E_NULL;
@@ -508,20 +620,8 @@ int odhs_system_place_random(odhs_system *sys, double phi, uint64_t seed)
     double *x = odhs__malloc_array(nd, sizeof(double));
     size_t *idx = odhs__malloc_array(n, sizeof(size_t));
     size_t *tmp = odhs__malloc_array(n, sizeof(size_t));
-    rsa_grid g = {dim, {1, 1, 1}, {1, 1, 1}, NULL, NULL};
-    double cw = 2.0 * sys->rmax;
-    size_t ncell = 1;
-    for (int k = 0; k < dim; ++k) {
-        double m = floor(L[k] / cw);
-        if (m > 4096) m = 4096;
-        g.nc[k] = m < 1 ? 1 : (int)m;
-    }
-    while ((double)g.nc[0] * g.nc[1] * g.nc[2] > 4.0 * (double)n + 64)
-        for (int k = 0; k < dim; ++k) g.nc[k] = g.nc[k] > 1 ? (g.nc[k] + 1) / 2 : 1;
-    for (int k = 0; k < dim; ++k) {
-        g.w[k] = L[k] / g.nc[k];
-        ncell *= (size_t)g.nc[k];
-    }
+    rsa_grid g = {dim, {1, 1, 1}, {1, 1, 1}, NULL, NULL, {1, 1, 1}, {{0}}};
+    size_t ncell = rsa_grid_size(&g, L, sys->rmax, n);
     g.head = odhs__malloc_array(ncell, sizeof(size_t));
     g.next = odhs__malloc_array(n, sizeof(size_t));
     if (!x || !idx || !tmp || !g.head || !g.next) {
@@ -531,73 +631,9 @@ int odhs_system_place_random(odhs_system *sys, double phi, uint64_t seed)
     for (size_t c = 0; c < ncell; ++c) g.head[c] = SIZE_MAX;
     for (size_t i = 0; i < n; ++i) idx[i] = i;
     sort_by_radius(idx, tmp, n, sys->r);
-
-    odhs_rng rng;
-    odhs__rng_seed(&rng, seed);
-    const uint64_t max_tries = 2000000; /* per particle */
-    int noff[3] = {1, 1, 1}, off[3][5];
-    for (int k = 0; k < 3; ++k) off[k][0] = 0;
-    for (int k = 0; k < dim; ++k) {
-        /* a placed particle can reach one cell away when w >= 2 rmax; coarse
-         * grids (few cells) visit every cell once */
-        if (g.nc[k] >= 3) {
-            noff[k] = 3;
-            off[k][0] = -1; off[k][1] = 0; off[k][2] = 1;
-        } else {
-            noff[k] = g.nc[k];
-            for (int m = 0; m < g.nc[k]; ++m) off[k][m] = m;
-        }
-    }
-    for (size_t p = 0; p < n; ++p) {
-        size_t i = idx[p];
-        double *xi = x + i * dim;
-        uint64_t t;
-        for (t = 0; t < max_tries; ++t) {
-            for (int k = 0; k < dim; ++k) xi[k] = odhs__rng_uniform(&rng) * L[k];
-            int ok = 1;
-            int c0[3] = {0, 0, 0};
-            for (int k = 0; k < dim; ++k) {
-                c0[k] = (int)floor(xi[k] / g.w[k]);
-                if (c0[k] >= g.nc[k]) c0[k] = g.nc[k] - 1;
-            }
-            for (int a = 0; a < noff[2] && ok; ++a)
-                for (int b = 0; b < noff[1] && ok; ++b)
-                    for (int e = 0; e < noff[0] && ok; ++e) {
-                        int cc[3] = {c0[0] + off[0][e], c0[1] + off[1][b], c0[2] + off[2][a]};
-                        size_t c = 0;
-                        for (int k = dim - 1; k >= 0; --k) {
-                            int ck = ((cc[k] % g.nc[k]) + g.nc[k]) % g.nc[k];
-                            if (g.nc[k] < 3) ck = cc[k] - c0[k]; /* absolute cell index */
-                            c = c * (size_t)g.nc[k] + (size_t)ck;
-                        }
-                        for (size_t j = g.head[c]; j != SIZE_MAX; j = g.next[j]) {
-                            double d[3] = {0, 0, 0};
-                            for (int k = 0; k < dim; ++k) d[k] = x[j * dim + k] - xi[k];
-                            odhs__min_image(dim, L, 0.0, d, NULL);
-                            double s2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                            double dd = sys->r[i] + sys->r[j];
-                            if (s2 < dd * dd) {
-                                ok = 0;
-                                break;
-                            }
-                        }
-                    }
-            if (ok) break;
-        }
-        if (t == max_tries) {
-            double vdone = 0.0, vol = L[0] * L[1] * (dim == 3 ? L[2] : 1.0);
-            for (size_t q = 0; q < p; ++q) vdone += particle_volume(dim, sys->r[idx[q]]);
-            st = odhs__syserr(sys, ODHS_E_TOODENSE,
-                              "random sequential addition stalled after placing %zu of %zu particles "
-                              "(phi = %.4f of the requested %.4f)",
-                              p, n, vdone / vol, phi);
-            goto done;
-        }
-        size_t c = rsa_cell(&g, xi);
-        g.next[i] = g.head[c];
-        g.head[c] = i;
-    }
-    st = commit_copy(sys, L, 0.0, sys->r, 1, x, 1);
+    rsa_stencil(&g);
+    st = rsa_place(sys, &g, L, idx, x, phi, seed);
+    if (st == ODHS_OK) st = commit_copy(sys, L, 0.0, sys->r, 1, x, 1);
 done:
     odhs__free(x);
     odhs__free(idx);
