@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# bench/regress_timing.sh - CPU time of every scene of the regression corpus
+# (tests/check_regress.c) with the library of another revision and with this
+# tree's, measured in the same run: the two runners alternate ROUNDS times and
+# each scene keeps its smallest CPU time per version. Prints a table with the
+# ratio new/old per scene and the total.
+#
+#   bench/regress_timing.sh [OLD_REV] [ROUNDS]     (defaults: 45abb07, 5)
+#
+# The old revision is checked out in a temporary git worktree and built there
+# with this tree's tests/check_regress.c and tests/data (the corpus uses only
+# the public API). Run it from the top of the repository on a quiet machine.
+set -euo pipefail
+old=${1:-45abb07}
+rounds=${2:-5}
+top=$(pwd)
+work=$(mktemp -d)
+trap 'git -C "$top" worktree remove --force "$work/old" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
+
+git worktree add --detach "$work/old" "$old" >/dev/null 2>&1
+# the old tree runs only the corpus suite: its own suites are not built
+mkdir -p "$work/old/tests.keep"
+mv "$work/old"/tests/check_*.c "$work/old/tests.keep/"
+cp tests/check_main.c tests/check_regress.c "$work/old/tests/"
+cp -R tests/data "$work/old/tests/"
+make -C "$work/old" -s -j2 tests >/dev/null
+make -s -j2 tests >/dev/null
+
+run() { # run DIR LABEL ROUND: one pass of the corpus, "label scene cpu" lines
+    (cd "$1" && CK_RUN_SUITE=regress CK_FORK=no OPENBLAS_NUM_THREADS=1 ./build/tests/run_tests 2>&1 >/dev/null) |
+        awk -v v="$2" '/^\[regress\]/ { print v, $2, $3 }'
+}
+for r in $(seq 1 "$rounds"); do
+    run "$work/old" old "$r"
+    run "$top" new "$r"
+done > "$work/times.txt"
+
+cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)
+echo "# regression corpus CPU time, $old against $(git rev-parse --short HEAD)$(git diff --quiet || echo '+changes')"
+echo "# machine: $cpu, $(nproc) CPUs; $rounds alternating rounds, smallest CPU time per scene and version"
+awk '
+    { k = $1 SUBSEP $2; if (!(k in t) || $3 < t[k]) t[k] = $3; if ($1 == "new" && !($2 in seen)) { seen[$2] = 1; order[++n] = $2 } }
+    END {
+        printf "%-26s %10s %10s %8s\n", "scene", "old s", "new s", "new/old"
+        worst = 0
+        for (i = 1; i <= n; ++i) {
+            s = order[i]; o = t["old" SUBSEP s]; w = t["new" SUBSEP s]
+            printf "%-26s %10.4f %10.4f %8.3f\n", s, o, w, o > 0 ? w / o : 0
+            to += o; tw += w
+            if (o >= 0.05 && w / o > worst) { worst = w / o; ws = s }
+        }
+        printf "%-26s %10.4f %10.4f %8.3f\n", "total", to, tw, tw / to
+        printf "# slowest ratio among scenes of >= 0.05 s: %.3f (%s)\n", worst, ws
+    }' "$work/times.txt"
