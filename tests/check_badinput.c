@@ -1554,6 +1554,31 @@ static int huge_rate_case(void)
     X(sp_next_off, odhs_driver_next_switch, ODHS_E_STATE, NOALT, H_DRVR, 0,                                    \
       double t = 5; int rc = odhs_driver_next_switch(w->drvr, &t);                                             \
       return t != 5 ? post("output written") : rc;)                                                            \
+    X(osc_null, odhs_driver_set_oscillatory_shear, ODHS_E_NULL, NOALT, H_NONE, 0,                             \
+      return odhs_driver_set_oscillatory_shear(NULL, ODHS_OSCILLATION_SINE, 0.1, 1.0, 0.0);)                    \
+    X(osc_shape, odhs_driver_set_oscillatory_shear, ODHS_E_INVALID, NOALT, H_DRV, 0,                           \
+      return odhs_driver_set_oscillatory_shear(w->drv, 7, 0.1, 1.0, 0.0);)                                      \
+    X(osc_amp0, odhs_driver_set_oscillatory_shear, ODHS_E_INVALID, NOALT, H_DRV, 0,                            \
+      return odhs_driver_set_oscillatory_shear(w->drv, ODHS_OSCILLATION_TRIANGLE, 0.0, 1.0, 0.0);)              \
+    X(osc_period_neg, odhs_driver_set_oscillatory_shear, ODHS_E_INVALID, NOALT, H_DRV, 0,                      \
+      return odhs_driver_set_oscillatory_shear(w->drv, ODHS_OSCILLATION_SINE, 0.1, -1.0, 0.0);)                 \
+    X(osc_nan, odhs_driver_set_oscillatory_shear, ODHS_E_NONFINITE, NOALT, H_DRV, 0,                           \
+      return odhs_driver_set_oscillatory_shear(w->drv, ODHS_OSCILLATION_SINE, NAN_, 1.0, 0.0);)                 \
+    X(osc_peak_overflow, odhs_driver_set_oscillatory_shear, ODHS_E_RANGE, NOALT, H_DRV, 0,                     \
+      return odhs_driver_set_oscillatory_shear(w->drv, ODHS_OSCILLATION_SINE, 1e300, 1e-300, 0.0);)             \
+    X(osc_with_pressure, odhs_driver_set_oscillatory_shear, ODHS_E_UNSUPPORTED, NOALT, H_RUN, 0,               \
+      int rc = odhs_driver_set_oscillatory_shear(w->drvr, ODHS_OSCILLATION_SINE, 0.1, 1.0, 0.0);                \
+      if (!rc) rc = odhs_driver_set_pressure(w->drvr, 1.0);                                                    \
+      if (rc) return post("setting up %d", rc);                                                                \
+      rc = odhs_stepper_step(w->run, NULL);                                                                    \
+      odhs_driver_clear_pressure(w->drvr);                                                                     \
+      odhs_driver_set_shear_rate(w->drvr, 1.0);                                                                \
+      return rc;)                                                                                              \
+    X(osc_get_null, odhs_driver_get_oscillatory_shear, ODHS_E_NULL, NOALT, H_NONE, 0,                          \
+      int sh; return odhs_driver_get_oscillatory_shear(NULL, &sh, NULL, NULL, NULL);)                           \
+    X(osc_get_off, odhs_driver_get_oscillatory_shear, ODHS_OK, NOALT, H_NONE, 0,                               \
+      int sh = 5; double a = 5; int rc = odhs_driver_get_oscillatory_shear(w->drv, &sh, &a, NULL, NULL);       \
+      return sh != 0 || a != 0.0 ? post("settings of no oscillation: %d %g", sh, a) : rc;)                     \
     X(grav_null, odhs_driver_set_gravity, ODHS_E_NULL, NOALT, H_NONE, 0,                                       \
       double g[2] = {0, -1}; return odhs_driver_set_gravity(NULL, 2, g);)                                      \
     X(grav_dim1, odhs_driver_set_gravity, ODHS_E_DIM, NOALT, H_DRV, 0,                                         \

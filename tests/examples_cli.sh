@@ -49,6 +49,20 @@ expect 0 "shear_flow dense solver" -- "$bin/shear_flow" --n 32 --phi 0.6 --strai
 expect 0 "shear_flow adaptive" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --integrator heun --tol 1e-8
 expect 2 "shear_flow bad integrator" -- "$bin/shear_flow" --integrator rk9
 expect 2 "shear_flow bad tol" -- "$bin/shear_flow" --tol 2
+# oscillatory shear (--oscillate A,T[,SHAPE]): series, stroboscopic file, bad values
+expect 0 "shear_flow oscillate" -- "$bin/shear_flow" --in "$tmp/c.xyz" --oscillate 0.05,1,triangle --cycles 2 --solver dense \
+    --per-cycle 4 --integrator heun --series "$tmp/o.csv" --strobe "$tmp/strobe.csv"
+expect_in o.csv "^time,strain,shear_stress,pressure,z,events" "shear_flow --oscillate writes its series header"
+[ "$(wc -l < "$tmp/o.csv")" -eq 10 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --oscillate series rows"; fail=$((fail + 1)); }
+expect_in strobe.csv "^cycle,strobe_rms,from_start,events" "shear_flow --strobe header"
+[ "$(wc -l < "$tmp/strobe.csv")" -eq 3 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --strobe rows"; fail=$((fail + 1)); }
+expect_in out "^# cycle 2: stroboscopic rms displacement" "shear_flow --oscillate reports the stroboscopic displacement"
+expect 0 "shear_flow oscillate sine" -- "$bin/shear_flow" --n 32 --phi 0.6 --oscillate 0.05,2 --cycles 1 --per-cycle 4 --solver dense
+for bad in 0.1 0,1 0.1,-1 0.1,1,square 0.1,1,sine,x nan,1; do
+    expect 2 "shear_flow --oscillate $bad" -- "$bin/shear_flow" --oscillate "$bad"
+done
+expect 2 "shear_flow --oscillate with --pressure" -- "$bin/shear_flow" --oscillate 0.1,1 --pressure 5
+expect 2 "shear_flow bad --cycles" -- "$bin/shear_flow" --oscillate 0.1,1 --cycles 0
 expect 0 "self_propulsion built-in" -- "$bin/self_propulsion" --n 64 --time 2 --every 1 --series "$tmp/p.csv" \
     --svg "$tmp/p.svg" --out "$tmp/p.xyz"
 expect_in p.csv "^time,mean_speed,pressure,z,collisions,openings" "self_propulsion writes its series header"

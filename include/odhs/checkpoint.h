@@ -21,8 +21,10 @@
  * xoshiro256** state, current forces and switch times) and GRAV (gravity
  * field and weights), and since 0.2.2 DRVC (the driver was changed after
  * the forces were solved: the restored stepper re-solves them at its next
- * step, as the original would have). A checkpoint that needs none of them is still written
- * as version 1, so older releases read it; this library reads both.
+ * step, as the original would have), and since 0.2.4 OSC (oscillatory shear:
+ * shape, amplitude, period, phase origin). A checkpoint that needs none of
+ * them is still written as version 1, so older releases read it; this library
+ * reads both.
  * Writes go to a temporary file in the same directory that is flushed, synced
  * and renamed over the target, so a crash mid-write leaves any previous
  * checkpoint intact. A truncated, corrupted or foreign file gives

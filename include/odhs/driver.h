@@ -86,6 +86,33 @@ ODHS_API const char *odhs_driver_errmsg(const odhs_driver *drv);
 ODHS_API int odhs_driver_set_mobility(odhs_driver *drv, double xi0);
 /** Simple shear rate gammadot (any finite value; 0 turns shear off). */
 ODHS_API int odhs_driver_set_shear_rate(odhs_driver *drv, double gammadot);
+/** Shapes of odhs_driver_set_oscillatory_shear. */
+enum {
+    /** gamma(t) = gamma0 sin(2 pi (t - t0) / T): peak rate 2 pi gamma0 / T */
+    ODHS_OSCILLATION_SINE = 1,
+    /** a constant rate +-4 gamma0 / T reversing every half period, at
+     *  t0 + T/4 + k T/2: gamma(t) the triangle wave between -gamma0 and
+     *  gamma0 through 0 at t0 (rising) */
+    ODHS_OSCILLATION_TRIANGLE = 2
+};
+/**
+ * Oscillatory simple shear of amplitude gamma0 > 0 and period T > 0 (times as
+ * the stepper's), shape ODHS_OSCILLATION_*, phase origin t0 (gamma(t0) = 0).
+ * Replaces the constant shear rate (odhs_driver_set_shear_rate replaces the
+ * oscillation in turn); odhs_driver_get_shear_rate then reports the peak
+ * rate, which sets the natural time unit. The stepper ends a step exactly at
+ * every reversal of the triangle shape; the accumulated strain
+ * (odhs_stepper_strain) is gamma(t) - gamma(t_start) exactly, while the box
+ * tilt follows the step chords (drift of the order of the integrator's
+ * error). Not with fixed pressure (ODHS_E_UNSUPPORTED at the next step);
+ * odhs_stepper_run_until_strain refuses it (the strain is not monotonic).
+ * Errors: ODHS_E_NULL, ODHS_E_NONFINITE, ODHS_E_INVALID, ODHS_E_RANGE.
+ */
+ODHS_API int odhs_driver_set_oscillatory_shear(odhs_driver *drv, int shape, double amplitude, double period,
+                                               double t0);
+/** The oscillation's settings (shape 0: none; outputs may be NULL). */
+ODHS_API int odhs_driver_get_oscillatory_shear(const odhs_driver *drv, int *shape, double *amplitude,
+                                               double *period, double *t0);
 /** Isotropic compression rate c (V_aff = -c R; c < 0 dilates; 0 = off). */
 ODHS_API int odhs_driver_set_compression_rate(odhs_driver *drv, double c);
 /**

@@ -1,7 +1,7 @@
 /* libodhs - the driver's checkpoint sections (include/odhs/checkpoint.h,
  * lib/io/ckpt.h): DRV (flow, pressure, fixed forces), and after the contacts
- * the optional PROP (self-propulsion), GRAV (gravity) and DRVC (the driver
- * changed after the forces were solved).
+ * the optional PROP (self-propulsion), GRAV (gravity), DRVC (the driver
+ * changed after the forces were solved) and OSC (oscillatory shear).
  *
  * A new optional section of the driver: write it in
  * odhs__ckpt_write_driver_tail (returning 2, the format version it needs) and
@@ -97,7 +97,14 @@ unsigned odhs__ckpt_write_driver_tail(odhs__wbuf *b, const odhs__ckpt_out *o)
         odhs__put_tag(b, "DRVC");
         odhs__put_u64(b, 1u);
     }
-    return drv->prop_on || drv->grav_on || o->drv_stale ? 2u : 1u;
+    if (drv->osc_shape) {
+        odhs__put_tag(b, "OSC ");
+        odhs__put_u64(b, (uint64_t)drv->osc_shape);
+        odhs__put_f64(b, drv->osc_amp);
+        odhs__put_f64(b, drv->osc_period);
+        odhs__put_f64(b, drv->osc_t0);
+    }
+    return drv->prop_on || drv->grav_on || o->drv_stale || drv->osc_shape ? 2u : 1u;
 }
 
 /* the readers of the optional sections: 1 read, 0 read before, or an error */
@@ -161,10 +168,29 @@ static int read_drvc(odhs__ckpt_in *in)
     return 1;
 }
 
+/* oscillatory shear: the settings as odhs_driver_set_oscillatory_shear
+ * checks them; the peak rate is DRV's shear rate */
+static int read_osc(odhs__ckpt_in *in)
+{
+    odhs__rbuf *b = &in->b;
+    odhs_driver *drv = in->drv;
+    if (drv->osc_shape) return 0;
+    uint64_t shape = odhs__get_u64(b);
+    double amp = odhs__get_f64(b), period = odhs__get_f64(b), t0 = odhs__get_f64(b);
+    if (b->bad || (shape != ODHS_OSCILLATION_SINE && shape != ODHS_OSCILLATION_TRIANGLE) || !isfinite(amp) ||
+        !isfinite(period) || !isfinite(t0) || !(amp > 0.0) || !(period > 0.0) || !(drv->gdot > 0.0))
+        return odhs__ckpt_bad(in, "checkpoint: oscillatory shear section malformed");
+    drv->osc_shape = (int)shape;
+    drv->osc_amp = amp;
+    drv->osc_period = period;
+    drv->osc_t0 = t0;
+    return 1;
+}
+
 static const struct {
     char tag[5];
     int (*read)(odhs__ckpt_in *in);
-} tail[] = {{"PROP", read_prop}, {"GRAV", read_grav}, {"DRVC", read_drvc}};
+} tail[] = {{"PROP", read_prop}, {"GRAV", read_grav}, {"DRVC", read_drvc}, {"OSC ", read_osc}};
 
 int odhs__ckpt_read_driver_tail(odhs__ckpt_in *in, const char *tag)
 {

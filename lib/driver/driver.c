@@ -58,6 +58,7 @@ int odhs_driver_set_shear_rate(odhs_driver *drv, double gammadot)
     if (!drv) return ODHS_E_NULL;
     if (!isfinite(gammadot)) return drverr(drv, ODHS_E_NONFINITE, "shear rate is not finite");
     drv->gdot = gammadot;
+    drv->osc_shape = 0; /* a constant rate replaces an oscillation */
     drv->version++;
     return ODHS_OK;
 }

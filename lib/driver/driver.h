@@ -36,6 +36,10 @@ struct odhs_driver {
     odhs_rng prng_b;   /* copy for the stepper's rollback */
     int pstarted_b;
     double *pF_b, *pts_b;
+    /* oscillatory shear (lib/driver/oscillation.c): shape 0 = off, else
+     * ODHS_OSCILLATION_*; gdot then holds the peak rate */
+    int osc_shape;
+    double osc_amp, osc_period, osc_t0;
     /* gravity */
     int grav_on, gdim;
     double g[3];
@@ -60,6 +64,13 @@ int odhs__driver_check_extra(const odhs_driver *d, size_t n, int dim);
 /* add propulsion and gravity to F (zeroed first when *has == 0; *has set when
  * anything was added). ODHS_E_DIM when the settings do not fit sys. */
 int odhs__driver_extra_forces(const odhs_driver *d, const odhs_system *sys, double *F, int *has);
+
+/* oscillatory shear (lib/driver/oscillation.c): the rate (side as for
+ * odhs__flow_shear_rate), the strain gamma(t), the first reversal after t
+ * (INFINITY for the sine) */
+double odhs__osc_rate(const odhs_driver *d, double t, int side);
+double odhs__osc_strain(const odhs_driver *d, double t);
+double odhs__osc_next_switch(const odhs_driver *d, double t);
 
 /* ---- the affine flow (lib/driver/flow.c) ----------------------------------
  * What the stepper needs of the driver's flow. Times are the stepper's. */

@@ -10,9 +10,7 @@
 
 double odhs__flow_shear_rate(const odhs_driver *d, double t, int side)
 {
-    (void)t;
-    (void)side;
-    return d->gdot;
+    return d->osc_shape ? odhs__osc_rate(d, t, side) : d->gdot;
 }
 
 void odhs__flow_gradient(const odhs_driver *d, double t, int side, int dim, double c_eff, double *G)
@@ -24,29 +22,36 @@ void odhs__flow_gradient(const odhs_driver *d, double t, int side, int dim, doub
 
 double odhs__flow_strain_increment(const odhs_driver *d, double t0, double dt)
 {
-    return dt * odhs__flow_shear_rate(d, t0, +1);
+    if (d->osc_shape) return odhs__osc_strain(d, t0 + dt) - odhs__osc_strain(d, t0);
+    return dt * d->gdot;
 }
 
 double odhs__flow_time_to_strain(const odhs_driver *d, double t, double strain, double target)
 {
-    double left = (target - strain) / odhs__flow_shear_rate(d, t, +1);
+    (void)t; /* a constant rate (oscillatory shear has no strain target) */
+    double left = (target - strain) / d->gdot;
     return fabs(target - strain) > 1e-15 * fmax(fabs(target), 1e-300) && left > 0.0 ? left : 0.0;
 }
 
 int odhs__flow_check_strain_target(const odhs_driver *d, char *errbuf)
 {
+    if (d->osc_shape)
+        return odhs__err(errbuf, ODHS_E_UNSUPPORTED,
+                         "run_until_strain with oscillatory shear: the strain is not monotonic (use run_until_time)");
     if (d->gdot == 0.0) return odhs__err(errbuf, ODHS_E_STATE, "run_until_strain needs a nonzero shear rate");
     return ODHS_OK;
 }
 
 double odhs__driver_next_switch(const odhs_driver *d, double t)
 {
-    (void)t;
-    return odhs__prop_next(d);
+    double tp = odhs__prop_next(d);
+    return d->osc_shape ? fmin(tp, odhs__osc_next_switch(d, t)) : tp;
 }
 
 int odhs__driver_check(const odhs_driver *d, size_t n, int dim, size_t nwalls, char *errbuf)
 {
+    if (d->pressure_on && d->osc_shape)
+        return odhs__err(errbuf, ODHS_E_UNSUPPORTED, "fixed pressure with oscillatory shear is not supported");
     if (d->pressure_on && d->gdot == 0.0)
         return odhs__err(errbuf, ODHS_E_UNSUPPORTED, "fixed pressure needs a nonzero shear rate");
     if (d->pressure_on && nwalls)
