@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal.h"
 #include "odhs.h"
 #include "testutil.h"
 
@@ -945,6 +946,43 @@ START_TEST(test_recreated_network)
 }
 END_TEST
 
+/* The stepper's solves on scratch networks (the isostatic sub-networks under
+ * fixed pressure, through the relaxed solve) must not keep the setup of a
+ * destroyed network that had the same address and version: with reuse = 0
+ * every fresh network is set up (0.2.3 reused it, and a fixed-pressure run
+ * gave different results depending on the heap's history). */
+START_TEST(test_recreated_network_relaxed)
+{
+    odhs_system *sys = NULL;
+    ck_assert_int_eq(odhs_system_create(2, 3, &sys), ODHS_OK);
+    double L[2] = {10, 10}, r[3] = {0.5, 0.5, 0.5};
+    odhs_solver *ge = NULL;
+    ck_assert_int_eq(odhs_solver_create(&ge_type, &ge), ODHS_OK);
+    ge_state *gs = ge_last;
+    int gfail = 0;
+    for (int it = 0; it < 40; ++it) {
+        double a = 0.05 * it;
+        double x[6] = {1.0, 1.0, 2.0, 1.0, 2.0 + cos(a), 1.0 + sin(a)};
+        ck_assert_int_eq(odhs_system_set_configuration(sys, L, 0.0, r, x), ODHS_OK);
+        odhs_network *net = NULL;
+        ck_assert_int_eq(odhs_network_create(sys, &net), ODHS_OK);
+        ck_assert_int_eq(odhs_network_add(net, 0, 1, ODHS_CONTACT_TEMPORARY), ODHS_OK);
+        ck_assert_int_eq(odhs_network_add(net, 1, 2, ODHS_CONTACT_TEMPORARY), ODHS_OK);
+        ck_assert_int_eq(odhs_network_update_geometry(net, sys), ODHS_OK);
+        double b[2] = {1.0, 2.0}, xg[2] = {0, 0}, c = cos(a);
+        double det = 4.0 - c * c, e0 = (2.0 * b[0] + c * b[1]) / det, e1 = (c * b[0] + 2.0 * b[1]) / det;
+        int sg = odhs__solver_solve_relaxed(ge, net, b, xg, 1e-7, 0);
+        if (sg != ODHS_OK || fabs(xg[0] - e0) > 1e-12 || fabs(xg[1] - e1) > 1e-12) gfail++;
+        odhs_network_destroy(net);
+    }
+    ck_assert_msg(gfail == 0 && gs->setups == 40,
+                  "relaxed solves on 40 fresh networks: %d wrong, %d setups (a destroyed network's setup was reused)",
+                  gfail, gs->setups);
+    odhs_solver_destroy(ge);
+    odhs_system_destroy(sys);
+}
+END_TEST
+
 /* The dense backend's reciprocal condition estimate against the exact
  * 1-norm condition number of N (from an explicit inverse by GE), and its
  * "min_rcond" threshold. */
@@ -1185,6 +1223,7 @@ Suite *make_solver_suite(void)
     tcase_add_test(tc, test_user_minimal_table);
     tcase_add_test(tc, test_setup_on_change);
     tcase_add_test(tc, test_recreated_network);
+    tcase_add_test(tc, test_recreated_network_relaxed);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("interface");

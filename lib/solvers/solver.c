@@ -355,15 +355,16 @@ int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b,
  * ~1e-19). Backends with a "tol" parameter (cg, cholmod-pcg, auto) stop
  * there for this call; the others solve as always. rtol is kept at least a
  * factor 10 below the result check's tolerance. */
-int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const double *b, double *x, double rtol)
+int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const double *b, double *x, double rtol,
+                               int reuse)
 {
     double cur;
     const odhs_solver_type *t = s->type;
     rtol = fmin(rtol, 0.1 * s->check_tol);
     if (!t->set_param || !t->get_stat || t->get_stat(s->state, "tol", &cur) != ODHS_OK || !(rtol > cur) ||
         t->set_param(s->state, "tol", rtol) != ODHS_OK)
-        return odhs__solver_solve(s, net, b, x, 1);
-    int st = odhs__solver_solve(s, net, b, x, 1);
+        return odhs__solver_solve(s, net, b, x, reuse);
+    int st = odhs__solver_solve(s, net, b, x, reuse);
     t->set_param(s->state, "tol", cur);
     return st;
 }

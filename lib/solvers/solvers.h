@@ -35,8 +35,13 @@ struct odhs_solver {
  * odhs__solver_invalidate when it may have been replaced); reuse = 0: set up
  * whenever the backend has a setup. */
 int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b, double *x, int reuse);
-/* the same with a relative residual of rtol where the backend has a "tol" */
-int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const double *b, double *x, double rtol);
+/* the same with a relative residual of rtol where the backend has a "tol".
+ * A scratch network (one made for this solve and destroyed after it) needs
+ * reuse = 0: a new one can get the address and version of the last one
+ * solved, and reuse = 1 would then keep that one's setup (the results then
+ * depended on the heap's history) */
+int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const double *b, double *x, double rtol,
+                               int reuse);
 void odhs__solver_invalidate(odhs_solver *s);
 
 #endif /* ODHS_SOLVERS_SOLVERS_H */

@@ -44,7 +44,7 @@ int odhs__st_correct(odhs_stepper *st, int *added)
         } else {
             /* the gaps are small: a relative residual of 1e-7 removes them to
              * round-off in one pass (a further pass follows if not) */
-            s = odhs__solver_solve_relaxed(st->sol, net, net->gap, st->cx, 1e-7);
+            s = odhs__solver_solve_relaxed(st->sol, net, net->gap, st->cx, 1e-7, 1);
             if (s) s = odhs__sterr(st, s, "force solve: %s", odhs_solver_errmsg(st->sol));
         }
         if (s) {

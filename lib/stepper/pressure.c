@@ -22,8 +22,9 @@ int odhs__st_solve_isostatic(odhs_stepper *st, const double *f0, double *rhs, do
     odhs_network *sub = odhs__net_subnet(net, NULL, nc, k);
     if (!sub) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     memset(x, 0, nc * sizeof *x);
-    int s = tol > 0.0 ? odhs__solver_solve_relaxed(st->sol, sub, rhs, x, tol)
-                      : odhs__solver_solve(st->sol, sub, rhs, x, 1);
+    /* sub is a scratch network: never reuse a setup by its address (reuse 0) */
+    int s = tol > 0.0 ? odhs__solver_solve_relaxed(st->sol, sub, rhs, x, tol, 0)
+                      : odhs__solver_solve(st->sol, sub, rhs, x, 0);
     odhs_network_destroy(sub);
     if (s) return odhs__sterr(st, s, "force solve on the isostatic network: %s", odhs_solver_errmsg(st->sol));
     memmove(x + k + 1, x + k, (nc - 1 - k) * sizeof *x);
