@@ -1225,6 +1225,8 @@ START_TEST(test_scene)
     line("scene %s", e->name);
     e->fn();
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t1);
+    fprintf(stderr, "[regress] %-26s %8.4f cpu s\n", e->name,
+            (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
     const char *rec = getenv("ODHS_REGRESS_RECORD");
     char path[1024];
     if (rec && *rec) {
@@ -1239,8 +1241,6 @@ START_TEST(test_scene)
         snprintf(path, sizeof path, "%s/regress/%s.txt", dir && *dir ? dir : "tests/data", e->name);
         compare(e, path, T);
     }
-    fprintf(stderr, "[regress] %-26s %8.4f cpu s %s\n", e->name,
-            (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec), rec && *rec ? path : "");
     free(T);
     T = NULL;
 }
