@@ -4,8 +4,7 @@
 
 #include "driver/driver.h"
 
-static int drverr(const odhs_driver *d, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
-static int drverr(const odhs_driver *d, int status, const char *fmt, ...)
+int odhs__drverr(const odhs_driver *d, int status, const char *fmt, ...)
 {
     if (!d) return status;
     va_list ap;
@@ -46,8 +45,8 @@ const char *odhs_driver_errmsg(const odhs_driver *drv) { return drv ? drv->errms
 int odhs_driver_set_mobility(odhs_driver *drv, double xi0)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!isfinite(xi0)) return drverr(drv, ODHS_E_NONFINITE, "mobility is not finite");
-    if (!(xi0 > 0.0)) return drverr(drv, ODHS_E_INVALID, "mobility %g must be > 0", xi0);
+    if (!isfinite(xi0)) return odhs__drverr(drv, ODHS_E_NONFINITE, "mobility is not finite");
+    if (!(xi0 > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "mobility %g must be > 0", xi0);
     drv->xi0 = xi0;
     drv->version++;
     return ODHS_OK;
@@ -56,7 +55,7 @@ int odhs_driver_set_mobility(odhs_driver *drv, double xi0)
 int odhs_driver_set_shear_rate(odhs_driver *drv, double gammadot)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!isfinite(gammadot)) return drverr(drv, ODHS_E_NONFINITE, "shear rate is not finite");
+    if (!isfinite(gammadot)) return odhs__drverr(drv, ODHS_E_NONFINITE, "shear rate is not finite");
     drv->gdot = gammadot;
     drv->osc_shape = 0; /* a constant rate replaces an oscillation */
     drv->version++;
@@ -66,7 +65,7 @@ int odhs_driver_set_shear_rate(odhs_driver *drv, double gammadot)
 int odhs_driver_set_compression_rate(odhs_driver *drv, double c)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!isfinite(c)) return drverr(drv, ODHS_E_NONFINITE, "compression rate is not finite");
+    if (!isfinite(c)) return odhs__drverr(drv, ODHS_E_NONFINITE, "compression rate is not finite");
     drv->crate = c;
     drv->version++;
     return ODHS_OK;
@@ -75,8 +74,8 @@ int odhs_driver_set_compression_rate(odhs_driver *drv, double c)
 int odhs_driver_set_pressure(odhs_driver *drv, double p)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!isfinite(p)) return drverr(drv, ODHS_E_NONFINITE, "pressure is not finite");
-    if (!(p > 0.0)) return drverr(drv, ODHS_E_INVALID, "pressure %g must be > 0", p);
+    if (!isfinite(p)) return odhs__drverr(drv, ODHS_E_NONFINITE, "pressure is not finite");
+    if (!(p > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "pressure %g must be > 0", p);
     drv->p = p;
     drv->pressure_on = 1;
     drv->version++;
@@ -95,8 +94,8 @@ int odhs_driver_clear_pressure(odhs_driver *drv)
 int odhs_driver_set_kappa_max(odhs_driver *drv, double kappa_max)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!isfinite(kappa_max)) return drverr(drv, ODHS_E_NONFINITE, "kappa_max is not finite");
-    if (!(kappa_max > 0.0)) return drverr(drv, ODHS_E_INVALID, "kappa_max must be > 0");
+    if (!isfinite(kappa_max)) return odhs__drverr(drv, ODHS_E_NONFINITE, "kappa_max is not finite");
+    if (!(kappa_max > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "kappa_max must be > 0");
     drv->kappa_max = kappa_max;
     drv->version++;
     return ODHS_OK;
@@ -112,13 +111,13 @@ int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const double *F)
         drv->version++;
         return ODHS_OK;
     }
-    if (dim != 2 && dim != 3) return drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
-    if (n == 0) return drverr(drv, ODHS_E_EMPTY, "no particles");
+    if (dim != 2 && dim != 3) return odhs__drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
+    if (n == 0) return odhs__drverr(drv, ODHS_E_EMPTY, "no particles");
     size_t nd = n * (size_t)dim;
     for (size_t k = 0; k < nd; ++k)
-        if (!isfinite(F[k])) return drverr(drv, ODHS_E_NONFINITE, "force component %zu is not finite", k);
+        if (!isfinite(F[k])) return odhs__drverr(drv, ODHS_E_NONFINITE, "force component %zu is not finite", k);
     double *c = odhs__malloc_array(nd, sizeof *c);
-    if (!c) return drverr(drv, ODHS_E_NOMEM, "out of memory");
+    if (!c) return odhs__drverr(drv, ODHS_E_NOMEM, "out of memory");
     memcpy(c, F, nd * sizeof *c);
     odhs__free(drv->F);
     drv->F = c;
@@ -147,8 +146,8 @@ int odhs_driver_set_force_callback(odhs_driver *drv, odhs_force_fn fn, void *ctx
 int odhs_driver_set_time_unit(odhs_driver *drv, double tau)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!isfinite(tau)) return drverr(drv, ODHS_E_NONFINITE, "time unit is not finite");
-    if (!(tau > 0.0)) return drverr(drv, ODHS_E_INVALID, "time unit must be > 0");
+    if (!isfinite(tau)) return odhs__drverr(drv, ODHS_E_NONFINITE, "time unit is not finite");
+    if (!(tau > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "time unit must be > 0");
     drv->tau_user = tau;
     drv->version++;
     return ODHS_OK;
@@ -157,7 +156,7 @@ int odhs_driver_set_time_unit(odhs_driver *drv, double tau)
 int odhs_driver_get_shear_rate(const odhs_driver *drv, double *g)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!g) return drverr(drv, ODHS_E_NULL, "output pointer is NULL");
+    if (!g) return odhs__drverr(drv, ODHS_E_NULL, "output pointer is NULL");
     *g = drv->gdot;
     return ODHS_OK;
 }
@@ -165,7 +164,7 @@ int odhs_driver_get_shear_rate(const odhs_driver *drv, double *g)
 int odhs_driver_get_compression_rate(const odhs_driver *drv, double *c)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!c) return drverr(drv, ODHS_E_NULL, "output pointer is NULL");
+    if (!c) return odhs__drverr(drv, ODHS_E_NULL, "output pointer is NULL");
     *c = drv->crate;
     return ODHS_OK;
 }
@@ -173,7 +172,7 @@ int odhs_driver_get_compression_rate(const odhs_driver *drv, double *c)
 int odhs_driver_get_mobility(const odhs_driver *drv, double *xi0)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!xi0) return drverr(drv, ODHS_E_NULL, "output pointer is NULL");
+    if (!xi0) return odhs__drverr(drv, ODHS_E_NULL, "output pointer is NULL");
     *xi0 = drv->xi0;
     return ODHS_OK;
 }
@@ -181,7 +180,7 @@ int odhs_driver_get_mobility(const odhs_driver *drv, double *xi0)
 int odhs_driver_get_pressure(const odhs_driver *drv, double *p, int *enabled)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!p || !enabled) return drverr(drv, ODHS_E_NULL, "output pointer is NULL");
+    if (!p || !enabled) return odhs__drverr(drv, ODHS_E_NULL, "output pointer is NULL");
     *p = drv->p;
     *enabled = drv->pressure_on;
     return ODHS_OK;
@@ -190,8 +189,8 @@ int odhs_driver_get_pressure(const odhs_driver *drv, double *p, int *enabled)
 int odhs_driver_time_unit(const odhs_driver *drv, const odhs_system *sys, double *tau)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!sys || !tau) return drverr(drv, ODHS_E_NULL, "NULL argument");
-    if (!sys->has_r) return drverr(drv, ODHS_E_STATE, "system radii are not set");
+    if (!sys || !tau) return odhs__drverr(drv, ODHS_E_NULL, "NULL argument");
+    if (!sys->has_r) return odhs__drverr(drv, ODHS_E_STATE, "system radii are not set");
     double rate = fmax(fabs(drv->gdot), fabs(drv->crate));
     if (rate > 0.0) {
         *tau = 1.0 / rate;
@@ -310,16 +309,16 @@ int odhs_driver_set_self_propulsion(odhs_driver *drv, size_t n, int dim, double 
                                     double tmax, uint64_t seed)
 {
     if (!drv) return ODHS_E_NULL;
-    if (dim != 2 && dim != 3) return drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
-    if (n == 0) return drverr(drv, ODHS_E_EMPTY, "no particles");
+    if (dim != 2 && dim != 3) return odhs__drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
+    if (n == 0) return odhs__drverr(drv, ODHS_E_EMPTY, "no particles");
     if (!isfinite(fmin) || !isfinite(fmax) || !isfinite(tmin) || !isfinite(tmax))
-        return drverr(drv, ODHS_E_NONFINITE, "propulsion parameters must be finite");
+        return odhs__drverr(drv, ODHS_E_NONFINITE, "propulsion parameters must be finite");
     if (!(fmin >= 0.0) || !(fmax > 0.0) || fmin > fmax)
-        return drverr(drv, ODHS_E_INVALID, "need 0 <= fmin <= fmax and fmax > 0 (got %g, %g)", fmin, fmax);
+        return odhs__drverr(drv, ODHS_E_INVALID, "need 0 <= fmin <= fmax and fmax > 0 (got %g, %g)", fmin, fmax);
     if (!(tmin >= 0.0) || !(tmax > 0.0) || tmin > tmax)
-        return drverr(drv, ODHS_E_INVALID, "need 0 <= tmin <= tmax and tmax > 0 (got %g, %g)", tmin, tmax);
-    if (n > SIZE_MAX / 3 / sizeof(double)) return drverr(drv, ODHS_E_NOMEM, "out of memory");
-    if (odhs__prop_alloc(drv, n, dim)) return drverr(drv, ODHS_E_NOMEM, "out of memory");
+        return odhs__drverr(drv, ODHS_E_INVALID, "need 0 <= tmin <= tmax and tmax > 0 (got %g, %g)", tmin, tmax);
+    if (n > SIZE_MAX / 3 / sizeof(double)) return odhs__drverr(drv, ODHS_E_NOMEM, "out of memory");
+    if (odhs__prop_alloc(drv, n, dim)) return odhs__drverr(drv, ODHS_E_NOMEM, "out of memory");
     drv->pfmin = fmin;
     drv->pfmax = fmax;
     drv->ptmin = tmin;
@@ -347,10 +346,10 @@ int odhs_driver_clear_self_propulsion(odhs_driver *drv)
 int odhs_driver_get_propulsion(const odhs_driver *drv, double *F, double *tswitch)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!F && !tswitch) return drverr(drv, ODHS_E_NULL, "both outputs are NULL");
-    if (!drv->prop_on) return drverr(drv, ODHS_E_STATE, "self-propulsion is off");
+    if (!F && !tswitch) return odhs__drverr(drv, ODHS_E_NULL, "both outputs are NULL");
+    if (!drv->prop_on) return odhs__drverr(drv, ODHS_E_STATE, "self-propulsion is off");
     if (tswitch && !drv->prop_started)
-        return drverr(drv, ODHS_E_STATE, "switch times are set when a stepper starts the propulsion clock");
+        return odhs__drverr(drv, ODHS_E_STATE, "switch times are set when a stepper starts the propulsion clock");
     if (F) memcpy(F, drv->pF, drv->pn * (size_t)drv->pdim * sizeof *F);
     if (tswitch) memcpy(tswitch, drv->pts, drv->pn * sizeof *tswitch);
     return ODHS_OK;
@@ -359,10 +358,10 @@ int odhs_driver_get_propulsion(const odhs_driver *drv, double *F, double *tswitc
 int odhs_driver_next_switch(const odhs_driver *drv, double *t)
 {
     if (!drv) return ODHS_E_NULL;
-    if (!t) return drverr(drv, ODHS_E_NULL, "output pointer is NULL");
-    if (!drv->prop_on) return drverr(drv, ODHS_E_STATE, "self-propulsion is off");
+    if (!t) return odhs__drverr(drv, ODHS_E_NULL, "output pointer is NULL");
+    if (!drv->prop_on) return odhs__drverr(drv, ODHS_E_STATE, "self-propulsion is off");
     if (!drv->prop_started)
-        return drverr(drv, ODHS_E_STATE, "switch times are set when a stepper starts the propulsion clock");
+        return odhs__drverr(drv, ODHS_E_STATE, "switch times are set when a stepper starts the propulsion clock");
     *t = odhs__prop_next(drv);
     return ODHS_OK;
 }
@@ -423,9 +422,9 @@ int odhs_driver_set_gravity(odhs_driver *drv, int dim, const double *g)
         memset(drv->g, 0, sizeof drv->g);
         return ODHS_OK;
     }
-    if (dim != 2 && dim != 3) return drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
+    if (dim != 2 && dim != 3) return odhs__drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
     for (int k = 0; k < dim; ++k)
-        if (!isfinite(g[k])) return drverr(drv, ODHS_E_NONFINITE, "gravity component %d is not finite", k);
+        if (!isfinite(g[k])) return odhs__drverr(drv, ODHS_E_NONFINITE, "gravity component %d is not finite", k);
     memset(drv->g, 0, sizeof drv->g);
     memcpy(drv->g, g, (size_t)dim * sizeof *g);
     drv->gdim = dim;
@@ -444,11 +443,11 @@ int odhs_driver_set_gravity_weights(odhs_driver *drv, size_t n, const double *w)
         drv->version++;
         return ODHS_OK;
     }
-    if (n == 0) return drverr(drv, ODHS_E_EMPTY, "no particles");
+    if (n == 0) return odhs__drverr(drv, ODHS_E_EMPTY, "no particles");
     for (size_t i = 0; i < n; ++i)
-        if (!isfinite(w[i])) return drverr(drv, ODHS_E_NONFINITE, "weight %zu is not finite", i);
+        if (!isfinite(w[i])) return odhs__drverr(drv, ODHS_E_NONFINITE, "weight %zu is not finite", i);
     double *c = odhs__malloc_array(n, sizeof *c);
-    if (!c) return drverr(drv, ODHS_E_NOMEM, "out of memory");
+    if (!c) return odhs__drverr(drv, ODHS_E_NOMEM, "out of memory");
     memcpy(c, w, n * sizeof *c);
     odhs__free(drv->gw);
     drv->gw = c;

@@ -47,7 +47,10 @@ struct odhs_driver {
     size_t gwn;
 };
 
-/* propulsion and gravity (lib/driver.c) */
+/* record an error message on the driver (logically mutable) */
+int odhs__drverr(const odhs_driver *d, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
+
+/* propulsion and gravity (lib/driver/driver.c) */
 double odhs__prop_fp(const odhs_driver *d);               /* sqrt(<|F_p|^2>) */
 /* allocate the propulsion arrays for n particles in dim (frees old ones) */
 int odhs__prop_alloc(odhs_driver *d, size_t n, int dim);

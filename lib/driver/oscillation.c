@@ -6,28 +6,18 @@
 
 #include "driver/driver.h"
 
-static int osc_err(const odhs_driver *d, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
-static int osc_err(const odhs_driver *d, int status, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    odhs__verr(((odhs_driver *)d)->errmsg, status, fmt, ap);
-    va_end(ap);
-    return status;
-}
-
 int odhs_driver_set_oscillatory_shear(odhs_driver *drv, int shape, double amplitude, double period, double t0)
 {
     if (!drv) return ODHS_E_NULL;
     if (!isfinite(amplitude) || !isfinite(period) || !isfinite(t0))
-        return osc_err(drv, ODHS_E_NONFINITE, "oscillatory shear: amplitude, period and phase origin must be finite");
+        return odhs__drverr(drv, ODHS_E_NONFINITE, "oscillatory shear: amplitude, period and phase origin must be finite");
     if (shape != ODHS_OSCILLATION_SINE && shape != ODHS_OSCILLATION_TRIANGLE)
-        return osc_err(drv, ODHS_E_INVALID, "oscillatory shear: unknown shape %d", shape);
-    if (!(amplitude > 0.0)) return osc_err(drv, ODHS_E_INVALID, "oscillatory shear: amplitude %g must be > 0", amplitude);
-    if (!(period > 0.0)) return osc_err(drv, ODHS_E_INVALID, "oscillatory shear: period %g must be > 0", period);
+        return odhs__drverr(drv, ODHS_E_INVALID, "oscillatory shear: unknown shape %d", shape);
+    if (!(amplitude > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "oscillatory shear: amplitude %g must be > 0", amplitude);
+    if (!(period > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "oscillatory shear: period %g must be > 0", period);
     double peak = (shape == ODHS_OSCILLATION_SINE ? 2.0 * ODHS_PI : 4.0) * amplitude / period;
     if (!isfinite(peak) || !(peak > 0.0))
-        return osc_err(drv, ODHS_E_RANGE, "oscillatory shear: the peak rate %g is not a finite positive number", peak);
+        return odhs__drverr(drv, ODHS_E_RANGE, "oscillatory shear: the peak rate %g is not a finite positive number", peak);
     drv->osc_shape = shape;
     drv->osc_amp = amplitude;
     drv->osc_period = period;

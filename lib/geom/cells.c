@@ -180,3 +180,40 @@ int odhs__pairs(int dim, size_t n, const double *x, const double *r, double rmax
     odhs__free(order);
     return status;
 }
+
+typedef struct {
+    size_t **pi, **pj, *np, *cap;
+    int nomem;
+} pair_list_ctx;
+
+static int pair_list_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)rij;
+    (void)gap;
+    pair_list_ctx *c = vctx;
+    if (*c->np == *c->cap) {
+        size_t cap = *c->cap ? 2 * *c->cap : 64;
+        size_t *a = odhs__realloc(*c->pi, cap * sizeof *a);
+        if (a) *c->pi = a;
+        size_t *b = a ? odhs__realloc(*c->pj, cap * sizeof *b) : NULL;
+        if (b) *c->pj = b;
+        if (!a || !b) {
+            c->nomem = 1;
+            return 1;
+        }
+        *c->cap = cap;
+    }
+    (*c->pi)[*c->np] = i;
+    (*c->pj)[*c->np] = j;
+    (*c->np)++;
+    return 0;
+}
+
+int odhs__pair_list(int dim, size_t n, const double *x, const double *r, double rmax, const double *L, double gamma,
+                    double max_gap, size_t **pi, size_t **pj, size_t *np, size_t *cap)
+{
+    pair_list_ctx c = {pi, pj, np, cap, 0};
+    *np = 0;
+    int s = odhs__pairs(dim, n, x, r, rmax, L, gamma, max_gap, pair_list_cb, &c);
+    return c.nomem || s == ODHS_E_NOMEM ? ODHS_E_NOMEM : ODHS_OK;
+}

@@ -32,6 +32,11 @@ void odhs__min_image(int dim, const double *L, double gamma, double *d, int *ima
  * Works on raw arrays so the stepper can use it with its own state. */
 int odhs__pairs(int dim, size_t n, const double *x, const double *r, double rmax,
                 const double *L, double gamma, double max_gap, odhs_pair_fn fn, void *ctx);
+/* The same pairs collected into the growable arrays *pi, *pj (capacity *cap,
+ * count *np; a Verlet list: the stepper's and the soft-core models'). Arrays
+ * keep what they held on error. ODHS_OK or ODHS_E_NOMEM. */
+int odhs__pair_list(int dim, size_t n, const double *x, const double *r, double rmax, const double *L, double gamma,
+                    double max_gap, size_t **pi, size_t **pj, size_t *np, size_t *cap);
 
 /* ---- hard walls ------------------------------------------------------------ */
 typedef struct {

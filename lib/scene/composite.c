@@ -15,16 +15,6 @@
 
 #include "stepper/stepper.h"
 
-static int cerr(const odhs_stepper *st, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
-static int cerr(const odhs_stepper *st, int status, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    odhs__verr(((odhs_stepper *)st)->errmsg, status, fmt, ap);
-    va_end(ap);
-    return status;
-}
-
 /* minimum-image separation j - i and its length */
 static double separation(const odhs_system *s, size_t i, size_t j, double *d)
 {
@@ -76,7 +66,7 @@ static int make_bond(odhs_network *net, size_t i, size_t j, double rest, bond_re
 
 static int check_index(const odhs_stepper *st, size_t i)
 {
-    if (i >= st->n) return cerr(st, ODHS_E_RANGE, "particle index %zu out of range (N = %zu)", i, st->n);
+    if (i >= st->n) return odhs__sterr(st, ODHS_E_RANGE, "particle index %zu out of range (N = %zu)", i, st->n);
     return ODHS_OK;
 }
 
@@ -85,23 +75,23 @@ int odhs_stepper_add_bond(odhs_stepper *st, size_t i, size_t j, double rest)
     if (!st) return ODHS_E_NULL;
     int s;
     if ((s = check_index(st, i)) || (s = check_index(st, j))) return s;
-    if (i == j) return cerr(st, ODHS_E_INVALID, "a bond needs two different particles");
-    if (!isfinite(rest)) return cerr(st, ODHS_E_NONFINITE, "rest length is not finite");
-    if (rest < 0.0) return cerr(st, ODHS_E_INVALID, "rest length %g must be >= 0 (0: current distance)", rest);
+    if (i == j) return odhs__sterr(st, ODHS_E_INVALID, "a bond needs two different particles");
+    if (!isfinite(rest)) return odhs__sterr(st, ODHS_E_NONFINITE, "rest length is not finite");
+    if (rest < 0.0) return odhs__sterr(st, ODHS_E_INVALID, "rest length %g must be >= 0 (0: current distance)", rest);
     double d[3];
     double r = separation(st->sys, i, j, d);
     if (rest == 0.0) rest = r;
-    if (!(rest > 0.0)) return cerr(st, ODHS_E_INVALID, "particles %zu and %zu are at the same position", i, j);
+    if (!(rest > 0.0)) return odhs__sterr(st, ODHS_E_INVALID, "particles %zu and %zu are at the same position", i, j);
     if (rest >= half_box(st->sys))
-        return cerr(st, ODHS_E_INVALID, "rest length %g is not below half the shortest box edge", rest);
+        return odhs__sterr(st, ODHS_E_INVALID, "rest length %g is not below half the shortest box edge", rest);
     if (fabs(r - rest) > 0.5 * rest)
-        return cerr(st, ODHS_E_INVALID,
+        return odhs__sterr(st, ODHS_E_INVALID,
                     "particles %zu and %zu are %g apart, too far from the rest length %g to be bonded", i, j, r,
                     rest);
     odhs_network *net = st->net;
     bond_rec rec;
     s = make_bond(net, i, j, rest, &rec);
-    if (s) return cerr(st, s, "%s", net->errmsg);
+    if (s) return odhs__sterr(st, s, "%s", net->errmsg);
     net->dist[odhs__net_find(net, i, j)] = r;
     st->ready = 0; /* forces and velocities are re-solved before the next step */
     return ODHS_OK;
@@ -110,34 +100,34 @@ int odhs_stepper_add_bond(odhs_stepper *st, size_t i, size_t j, double rest)
 int odhs_stepper_add_chain(odhs_stepper *st, size_t k, const size_t *beads)
 {
     if (!st) return ODHS_E_NULL;
-    if (!beads) return cerr(st, ODHS_E_NULL, "beads pointer is NULL");
-    if (k < 2) return cerr(st, ODHS_E_INVALID, "a chain needs at least 2 beads (got %zu)", k);
+    if (!beads) return odhs__sterr(st, ODHS_E_NULL, "beads pointer is NULL");
+    if (k < 2) return odhs__sterr(st, ODHS_E_INVALID, "a chain needs at least 2 beads (got %zu)", k);
     int s;
     for (size_t a = 0; a < k; ++a) {
         if ((s = check_index(st, beads[a]))) return s;
         for (size_t b = 0; b < a; ++b)
-            if (beads[a] == beads[b]) return cerr(st, ODHS_E_INVALID, "bead %zu listed twice", beads[a]);
+            if (beads[a] == beads[b]) return odhs__sterr(st, ODHS_E_INVALID, "bead %zu listed twice", beads[a]);
     }
     odhs_network *net = st->net;
     double hb = half_box(st->sys), d[3];
     for (size_t a = 0; a + 1 < k; ++a) {
         double r = separation(st->sys, beads[a], beads[a + 1], d);
         if (!(r > 0.0) || r >= hb)
-            return cerr(st, ODHS_E_INVALID, "beads %zu and %zu are %g apart: cannot bond them", beads[a],
+            return odhs__sterr(st, ODHS_E_INVALID, "beads %zu and %zu are %g apart: cannot bond them", beads[a],
                         beads[a + 1], r);
         size_t c = odhs__net_find(net, beads[a], beads[a + 1]);
         if (c != SIZE_MAX && net->kind[c] == ODHS_CONTACT_PERMANENT)
-            return cerr(st, ODHS_E_INVALID, "beads %zu and %zu are already bonded", beads[a], beads[a + 1]);
+            return odhs__sterr(st, ODHS_E_INVALID, "beads %zu and %zu are already bonded", beads[a], beads[a + 1]);
     }
     bond_rec *rec = odhs__malloc_array(k, sizeof *rec);
-    if (!rec) return cerr(st, ODHS_E_NOMEM, "out of memory");
+    if (!rec) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     size_t m = 0;
     for (size_t a = 0; a + 1 < k; ++a) {
         double r = separation(st->sys, beads[a], beads[a + 1], d);
         if ((s = make_bond(net, beads[a], beads[a + 1], r, &rec[m]))) {
             undo_bonds(net, rec, m);
             odhs__free(rec);
-            return cerr(st, s, "%s", net->errmsg);
+            return odhs__sterr(st, s, "%s", net->errmsg);
         }
         net->dist[odhs__net_find(net, beads[a], beads[a + 1])] = r;
         m++;
@@ -181,15 +171,15 @@ static int check_body_beads(const odhs_stepper *st, size_t k, const size_t *bead
     for (size_t a = 0; a < k; ++a) {
         if ((s = check_index(st, beads[a]))) return s;
         for (size_t b = 0; b < a; ++b)
-            if (beads[a] == beads[b]) return cerr(st, ODHS_E_INVALID, "bead %zu listed twice", beads[a]);
+            if (beads[a] == beads[b]) return odhs__sterr(st, ODHS_E_INVALID, "bead %zu listed twice", beads[a]);
         if (net->rbody && net->rbody[beads[a]] != SIZE_MAX)
-            return cerr(st, ODHS_E_INVALID, "bead %zu already belongs to a rigid body", beads[a]);
+            return odhs__sterr(st, ODHS_E_INVALID, "bead %zu already belongs to a rigid body", beads[a]);
     }
     double d[3];
     for (size_t a = 0; a < k; ++a)
         for (size_t b = 0; b < a; ++b) {
             double r = separation(sys, beads[a], beads[b], d);
-            if (!(r > 0.0)) return cerr(st, ODHS_E_INVALID, "beads %zu and %zu coincide", beads[a], beads[b]);
+            if (!(r > 0.0)) return odhs__sterr(st, ODHS_E_INVALID, "beads %zu and %zu coincide", beads[a], beads[b]);
         }
     return ODHS_OK;
 }
@@ -263,14 +253,14 @@ static int plan_bonds(const odhs_stepper *st, size_t k, const size_t *beads, siz
         size_t besta[3] = {0, 0, 0};
         size_t bestp = next_bead(sys, k, beads, order, nplaced, placed, need, besta);
         if (bestp == SIZE_MAX)
-            return cerr(st, ODHS_E_INVALID,
+            return odhs__sterr(st, ODHS_E_INVALID,
                         "the beads are (nearly) %s: distance constraints cannot make them a rigid body "
                         "(use a chain, or beads off one %s)",
                         dim == 2 ? "collinear" : "coplanar or collinear", dim == 2 ? "line" : "plane");
         for (int t = 0; t < need; ++t) {
             double r = separation(sys, beads[bestp], besta[t], d);
             if (r >= hb)
-                return cerr(st, ODHS_E_INVALID, "beads %zu and %zu are %g apart: not below half the box edge",
+                return odhs__sterr(st, ODHS_E_INVALID, "beads %zu and %zu are %g apart: not below half the box edge",
                             beads[bestp], besta[t], r);
             size_t c = odhs__net_find(net, beads[bestp], besta[t]);
             if (c != SIZE_MAX && net->kind[c] == ODHS_CONTACT_PERMANENT)
@@ -297,7 +287,7 @@ static int make_body_bonds(odhs_stepper *st, const size_t *bi, const size_t *bj,
         double r = separation(sys, bi[b], bj[b], d);
         if ((s = make_bond(net, bi[b], bj[b], r, &rec[m]))) {
             undo_bonds(net, rec, m);
-            return cerr(st, s, "%s", net->errmsg);
+            return odhs__sterr(st, s, "%s", net->errmsg);
         }
         net->dist[odhs__net_find(net, bi[b], bj[b])] = r;
         m++;
@@ -308,8 +298,8 @@ static int make_body_bonds(odhs_stepper *st, const size_t *bi, const size_t *bj,
 int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
 {
     if (!st) return ODHS_E_NULL;
-    if (!beads) return cerr(st, ODHS_E_NULL, "beads pointer is NULL");
-    if (k < 2) return cerr(st, ODHS_E_INVALID, "a rigid body needs at least 2 beads (got %zu)", k);
+    if (!beads) return odhs__sterr(st, ODHS_E_NULL, "beads pointer is NULL");
+    if (k < 2) return odhs__sterr(st, ODHS_E_INVALID, "a rigid body needs at least 2 beads (got %zu)", k);
     odhs_network *net = st->net;
     int dim = st->dim;
     int s = check_body_beads(st, k, beads);
@@ -320,7 +310,7 @@ int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
     bond_rec *rec = odhs__malloc_array(nbmax, sizeof *rec);
     unsigned char *placed = odhs__calloc(k, 1);
     if (!order || !bi || !bj || !rec || !placed) {
-        s = cerr(st, ODHS_E_NOMEM, "out of memory");
+        s = odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
         goto done;
     }
     size_t nb = 0;
@@ -328,7 +318,7 @@ int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
     if (!net->rbody) {
         net->rbody = odhs__malloc_array(st->n, sizeof *net->rbody);
         if (!net->rbody) {
-            s = cerr(st, ODHS_E_NOMEM, "out of memory");
+            s = odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
             goto done;
         }
         for (size_t i = 0; i < st->n; ++i) net->rbody[i] = SIZE_MAX;
@@ -355,7 +345,7 @@ done:
 int odhs_stepper_bond_count(const odhs_stepper *st, size_t *count)
 {
     if (!st) return ODHS_E_NULL;
-    if (!count) return cerr(st, ODHS_E_NULL, "output pointer is NULL");
+    if (!count) return odhs__sterr(st, ODHS_E_NULL, "output pointer is NULL");
     *count = st->net->nperm;
     return ODHS_OK;
 }

@@ -5,16 +5,6 @@
 
 #include "stepper/stepper.h"
 
-static int werr(const odhs_stepper *st, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
-static int werr(const odhs_stepper *st, int status, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    odhs__verr(((odhs_stepper *)st)->errmsg, status, fmt, ap);
-    va_end(ap);
-    return status;
-}
-
 static int finite_vec(const double *v, int dim)
 {
     for (int k = 0; k < dim; ++k)
@@ -38,8 +28,8 @@ static int add_wall(odhs_stepper *st, odhs_wall *w, size_t *id)
         }
     }
     if (wi != SIZE_MAX)
-        return werr(st, ODHS_E_OVERLAP, "particle %zu overlaps the new wall by %.6g", wi, worst);
-    if (odhs__net_add_wall(st->net, w)) return werr(st, ODHS_E_NOMEM, "out of memory");
+        return odhs__sterr(st, ODHS_E_OVERLAP, "particle %zu overlaps the new wall by %.6g", wi, worst);
+    if (odhs__net_add_wall(st->net, w)) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     if (id) *id = st->net->nwalls - 1;
     st->ready = 0; /* the next step (or reset) finds the wall contacts and re-solves */
     return ODHS_OK;
@@ -48,13 +38,13 @@ static int add_wall(odhs_stepper *st, odhs_wall *w, size_t *id)
 int odhs_stepper_add_wall_plane(odhs_stepper *st, const double *normal, double offset, size_t *id)
 {
     if (!st) return ODHS_E_NULL;
-    if (!normal) return werr(st, ODHS_E_NULL, "normal is NULL");
+    if (!normal) return odhs__sterr(st, ODHS_E_NULL, "normal is NULL");
     int dim = st->dim;
-    if (!finite_vec(normal, dim) || !isfinite(offset)) return werr(st, ODHS_E_NONFINITE, "wall plane is not finite");
+    if (!finite_vec(normal, dim) || !isfinite(offset)) return odhs__sterr(st, ODHS_E_NONFINITE, "wall plane is not finite");
     double nn = 0.0;
     for (int k = 0; k < dim; ++k) nn += normal[k] * normal[k];
     nn = sqrt(nn);
-    if (!(nn > 0.0) || !isfinite(nn)) return werr(st, ODHS_E_INVALID, "the plane's normal is zero");
+    if (!(nn > 0.0) || !isfinite(nn)) return odhs__sterr(st, ODHS_E_INVALID, "the plane's normal is zero");
     odhs_wall w;
     memset(&w, 0, sizeof w);
     w.type = ODHS_WALL_PLANE;
@@ -66,10 +56,10 @@ int odhs_stepper_add_wall_plane(odhs_stepper *st, const double *normal, double o
 int odhs_stepper_add_wall_sphere(odhs_stepper *st, const double *centre, double radius, size_t *id)
 {
     if (!st) return ODHS_E_NULL;
-    if (!centre) return werr(st, ODHS_E_NULL, "centre is NULL");
+    if (!centre) return odhs__sterr(st, ODHS_E_NULL, "centre is NULL");
     int dim = st->dim;
-    if (!finite_vec(centre, dim) || !isfinite(radius)) return werr(st, ODHS_E_NONFINITE, "wall sphere is not finite");
-    if (!(radius > 0.0)) return werr(st, ODHS_E_INVALID, "radius %g must be > 0", radius);
+    if (!finite_vec(centre, dim) || !isfinite(radius)) return odhs__sterr(st, ODHS_E_NONFINITE, "wall sphere is not finite");
+    if (!(radius > 0.0)) return odhs__sterr(st, ODHS_E_INVALID, "radius %g must be > 0", radius);
     odhs_wall w;
     memset(&w, 0, sizeof w);
     w.type = ODHS_WALL_SPHERE;
@@ -81,11 +71,11 @@ int odhs_stepper_add_wall_sphere(odhs_stepper *st, const double *centre, double 
 int odhs_stepper_add_wall_segment(odhs_stepper *st, const double *a, const double *b, size_t *id)
 {
     if (!st) return ODHS_E_NULL;
-    if (!a || !b) return werr(st, ODHS_E_NULL, "segment end is NULL");
-    if (st->dim != 2) return werr(st, ODHS_E_DIM, "segment walls are 2D only");
-    if (!finite_vec(a, 2) || !finite_vec(b, 2)) return werr(st, ODHS_E_NONFINITE, "segment is not finite");
+    if (!a || !b) return odhs__sterr(st, ODHS_E_NULL, "segment end is NULL");
+    if (st->dim != 2) return odhs__sterr(st, ODHS_E_DIM, "segment walls are 2D only");
+    if (!finite_vec(a, 2) || !finite_vec(b, 2)) return odhs__sterr(st, ODHS_E_NONFINITE, "segment is not finite");
     double l = hypot(b[0] - a[0], b[1] - a[1]);
-    if (!(l > 0.0)) return werr(st, ODHS_E_INVALID, "the segment's ends coincide");
+    if (!(l > 0.0)) return odhs__sterr(st, ODHS_E_INVALID, "the segment's ends coincide");
     odhs_wall w;
     memset(&w, 0, sizeof w);
     w.type = ODHS_WALL_SEGMENT;
@@ -101,7 +91,7 @@ int odhs_stepper_add_wall_segment(odhs_stepper *st, const double *a, const doubl
 static int check_id(const odhs_stepper *st, size_t id)
 {
     if (id >= st->net->nwalls)
-        return werr(st, ODHS_E_RANGE, "wall %zu does not exist (%zu walls)", id, st->net->nwalls);
+        return odhs__sterr(st, ODHS_E_RANGE, "wall %zu does not exist (%zu walls)", id, st->net->nwalls);
     return ODHS_OK;
 }
 
@@ -110,8 +100,8 @@ int odhs_stepper_set_wall_velocity(odhs_stepper *st, size_t id, const double *v)
     if (!st) return ODHS_E_NULL;
     int s = check_id(st, id);
     if (s) return s;
-    if (!v) return werr(st, ODHS_E_NULL, "velocity is NULL");
-    if (!finite_vec(v, st->dim)) return werr(st, ODHS_E_NONFINITE, "wall velocity is not finite");
+    if (!v) return odhs__sterr(st, ODHS_E_NULL, "velocity is NULL");
+    if (!finite_vec(v, st->dim)) return odhs__sterr(st, ODHS_E_NONFINITE, "wall velocity is not finite");
     odhs_wall *w = &st->net->walls[id];
     for (int k = 0; k < st->dim; ++k) w->v[k] = v[k];
     /* the forces depend on the wall velocity: re-solve before the next step,
@@ -123,7 +113,7 @@ int odhs_stepper_set_wall_velocity(odhs_stepper *st, size_t id, const double *v)
 int odhs_stepper_wall_count(const odhs_stepper *st, size_t *count)
 {
     if (!st) return ODHS_E_NULL;
-    if (!count) return werr(st, ODHS_E_NULL, "output pointer is NULL");
+    if (!count) return odhs__sterr(st, ODHS_E_NULL, "output pointer is NULL");
     *count = st->net->nwalls;
     return ODHS_OK;
 }
@@ -131,7 +121,7 @@ int odhs_stepper_wall_count(const odhs_stepper *st, size_t *count)
 int odhs_stepper_wall_force(const odhs_stepper *st, size_t id, double *force)
 {
     if (!st) return ODHS_E_NULL;
-    if (!force) return werr(st, ODHS_E_NULL, "output pointer is NULL");
+    if (!force) return odhs__sterr(st, ODHS_E_NULL, "output pointer is NULL");
     int s = check_id(st, id);
     if (s) return s;
     const odhs_network *net = st->net;
@@ -146,7 +136,7 @@ int odhs_stepper_wall_force(const odhs_stepper *st, size_t id, double *force)
 int odhs_stepper_wall_displacement(const odhs_stepper *st, size_t id, double *disp)
 {
     if (!st) return ODHS_E_NULL;
-    if (!disp) return werr(st, ODHS_E_NULL, "output pointer is NULL");
+    if (!disp) return odhs__sterr(st, ODHS_E_NULL, "output pointer is NULL");
     int s = check_id(st, id);
     if (s) return s;
     for (int k = 0; k < st->dim; ++k) disp[k] = st->net->walls[id].disp[k];

@@ -10,27 +10,6 @@
 #include "softcore/softcore.h"
 
 /* ---- neighbour list ------------------------------------------------------------ */
-static int nb_push(size_t i, size_t j, const double *rij, double gap, void *ctx)
-{
-    (void)rij;
-    (void)gap;
-    odhs_softcore *sc = ctx;
-    if (sc->np == sc->pcap) {
-        size_t cap = sc->pcap ? 2 * sc->pcap : 64;
-        size_t *a = odhs__realloc(sc->pi, cap * sizeof *a);
-        if (!a) return 1;
-        sc->pi = a;
-        size_t *b = odhs__realloc(sc->pj, cap * sizeof *b);
-        if (!b) return 1;
-        sc->pj = b;
-        sc->pcap = cap;
-    }
-    sc->pi[sc->np] = i;
-    sc->pj[sc->np] = j;
-    sc->np++;
-    return 0;
-}
-
 static int key_cmp(const void *a, const void *b)
 {
     uint64_t u = *(const uint64_t *)a, v = *(const uint64_t *)b;
@@ -43,9 +22,8 @@ static int nb_build(odhs_softcore *sc, const double *x)
     int d = sc->dim;
     memcpy(sc->xw, x, sc->nd * sizeof *x);
     for (size_t i = 0; i < sc->n; ++i) odhs__wrap(d, sys->L, sys->gamma, sc->xw + i * d);
-    sc->np = 0;
-    int s = odhs__pairs(d, sc->n, sc->xw, sys->r, sys->rmax, sys->L, sys->gamma, sc->skin, nb_push, sc);
-    if (s == ODHS_STOPPED) s = ODHS_E_NOMEM;
+    int s = odhs__pair_list(d, sc->n, sc->xw, sys->r, sys->rmax, sys->L, sys->gamma, sc->skin, &sc->pi, &sc->pj,
+                            &sc->np, &sc->pcap);
     if (s == ODHS_OK && sc->np > sc->pkcap) {
         uint64_t *k = odhs__realloc(sc->pk, sc->pcap * sizeof *k);
         if (!k) s = ODHS_E_NOMEM;

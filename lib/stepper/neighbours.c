@@ -8,35 +8,6 @@
 #include "stepper/stepper.h"
 
 /* ---- neighbour list ----------------------------------------------------- */
-typedef struct {
-    odhs_stepper *st;
-    int status;
-} nb_ctx;
-
-static int nb_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
-{
-    (void)rij;
-    (void)gap;
-    nb_ctx *c = vctx;
-    odhs_stepper *st = c->st;
-    if (st->npairs == st->pcap) {
-        size_t cap = st->pcap ? 2 * st->pcap : 1024;
-        size_t *a = odhs__realloc(st->pi, cap * sizeof *a);
-        if (a) st->pi = a;
-        size_t *b = odhs__realloc(st->pj, cap * sizeof *b);
-        if (b) st->pj = b;
-        if (!a || !b) {
-            c->status = ODHS_E_NOMEM;
-            return 1;
-        }
-        st->pcap = cap;
-    }
-    st->pi[st->npairs] = i;
-    st->pj[st->npairs] = j;
-    st->npairs++;
-    return 0;
-}
-
 int odhs__st_build_neighbours(odhs_stepper *st)
 {
     odhs_system *s = st->sys;
@@ -54,10 +25,9 @@ int odhs__st_build_neighbours(odhs_stepper *st)
                      Lmin, 2.0 * s->rmax);
     st->skin = skin;
     st->rc = 2.0 * s->rmax + skin;
-    st->npairs = 0;
-    nb_ctx c = {st, ODHS_OK};
-    int r = odhs__pairs(st->dim, st->n, s->x, s->r, s->rmax, s->L, s->gamma, skin, nb_cb, &c);
-    if (r == ODHS_E_NOMEM || c.status) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+    if (odhs__pair_list(st->dim, st->n, s->x, s->r, s->rmax, s->L, s->gamma, skin, &st->pi, &st->pj, &st->npairs,
+                        &st->pcap))
+        return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     memset(st->disp, 0, st->nd * sizeof *st->disp);
     memset(st->M, 0, sizeof st->M);
     for (int a = 0; a < 3; ++a) st->M[3 * (a) + (a)] = 1.0;
