@@ -6,12 +6,22 @@
 # ratio new/old per scene and the total.
 #
 #   bench/regress_timing.sh [OLD_REV] [ROUNDS]     (defaults: 45abb07, 5)
+#   ODHS_TIMING=instructions bench/regress_timing.sh [OLD_REV]
+#
+# CPU time on a shared virtual machine scatters by 10-30 % per scene even as
+# the smallest of several runs; the second form counts the instructions each
+# scene executes instead (valgrind --tool=callgrind, about 50 times slower,
+# one round): deterministic, so a difference of 0.1 % is real.
 #
 # The old revision is checked out in a temporary git worktree and built there
 # with this tree's tests/check_regress.c and tests/data (the corpus uses only
 # the public API). Run it from the top of the repository on a quiet machine.
 set -euo pipefail
 old=${1:-45abb07}
+if [ "${ODHS_TIMING:-cpu}" = instructions ] && ! command -v valgrind >/dev/null; then
+    echo "regress_timing: ODHS_TIMING=instructions needs valgrind (Debian: apt-get install valgrind)" >&2
+    exit 2
+fi
 rounds=${2:-5}
 top=$(pwd)
 work=$(mktemp -d)
@@ -26,6 +36,13 @@ cp -R tests/data "$work/old/tests/"
 make -C "$work/old" -s -j2 tests >/dev/null
 make -s -j2 tests >/dev/null
 
+ir() { # ir DIR LABEL SCENE: one scene under callgrind, a "label scene instructions" line
+    local n
+    n=$(cd "$1" && CK_RUN_SUITE=regress CK_RUN_CASE="$3" CK_FORK=no OPENBLAS_NUM_THREADS=1 \
+        valgrind --tool=callgrind --callgrind-out-file=/dev/null ./build/tests/run_tests 2>&1 >/dev/null |
+        sed -n 's/.*Collected : \([0-9]*\).*/\1/p') || true
+    echo "$2 $3 $n"
+}
 run() { # run DIR LABEL SCENE: one scene, a "label scene cpu" line
     # the old revision fails the scenes whose recorded results changed since:
     # only the timings count here
@@ -36,27 +53,38 @@ scenes=$(CK_RUN_SUITE=regress CK_FORK=no OPENBLAS_NUM_THREADS=1 ./build/tests/ru
          awk '/^\[regress\]/ { print $2 }')
 # scene by scene, the two versions one after the other (a drift of the
 # machine's speed then hits both alike), the order of the pair alternating
+unit="s"
+if [ "${ODHS_TIMING:-cpu}" = instructions ]; then
+    unit="Ir"
+    rounds=1
+    for s in $scenes; do ir "$work/old" old "$s"; ir "$top" new "$s"; done > "$work/times.txt"
+else
 for r in $(seq 1 "$rounds"); do
     for s in $scenes; do
         if [ $((r % 2)) -eq 1 ]; then run "$work/old" old "$s"; run "$top" new "$s";
         else run "$top" new "$s"; run "$work/old" old "$s"; fi
     done
 done > "$work/times.txt"
+fi
 
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)
-echo "# regression corpus CPU time, $old against $(git rev-parse --short HEAD)$(git diff --quiet || echo '+changes')"
-echo "# machine: $cpu, $(nproc) CPUs; $rounds rounds, scene by scene in turns, smallest CPU time per scene and version"
-awk '
+echo "# regression corpus, cost per scene, $old against $(git rev-parse --short HEAD)$(git diff --quiet || echo '+changes')"
+if [ "$unit" = Ir ]; then
+    echo "# machine: $cpu, $(nproc) CPUs; instructions executed per scene (callgrind), one run each"
+else
+    echo "# machine: $cpu, $(nproc) CPUs; $rounds rounds, scene by scene in turns, smallest CPU time per scene and version"
+fi
+awk -v unit="$unit" '
     { k = $1 SUBSEP $2; if (!(k in t) || $3 < t[k]) t[k] = $3; if ($1 == "new" && !($2 in seen)) { seen[$2] = 1; order[++n] = $2 } }
     END {
-        printf "%-26s %10s %10s %8s\n", "scene", "old s", "new s", "new/old"
+        printf "%-26s %14s %14s %8s\n", "scene", "old " unit, "new " unit, "new/old"
         worst = 0
         for (i = 1; i <= n; ++i) {
             s = order[i]; o = t["old" SUBSEP s]; w = t["new" SUBSEP s]
-            printf "%-26s %10.4f %10.4f %8.3f\n", s, o, w, (o > 0 ? w / o : 0)
+            printf "%-26s %14.6g %14.6g %8.4f\n", s, o, w, (o > 0 ? w / o : 0)
             to += o; tw += w
-            if (o >= 0.05 && w / o > worst) { worst = w / o; ws = s }
+            if ((unit == "Ir" || o >= 0.05) && w / o > worst) { worst = w / o; ws = s }
         }
-        printf "%-26s %10.4f %10.4f %8.3f\n", "total", to, tw, tw / to
-        printf "# slowest ratio among scenes of >= 0.05 s: %.3f (%s)\n", worst, ws
+        printf "%-26s %14.6g %14.6g %8.4f\n", "total", to, tw, tw / to
+        printf "# largest ratio%s: %.4f (%s)\n", unit == "Ir" ? "" : " among scenes of >= 0.05 s", worst, ws
     }' "$work/times.txt"

@@ -249,7 +249,7 @@ static int heun_at_opening(odhs_stepper *st, odhs__step_plan *p, int *again)
     double fbig = 0.0, tstar = INFINITY, t = p->t;
     for (size_t c = 0; c < net->nc; ++c) fbig = fmax(fbig, fabs(net->f[c]));
     for (size_t c = 0; c < net->nc; ++c) {
-        double f0 = st->sf[c], f1 = net->f[c];
+        double f0 = st->fr[c], f1 = net->f[c];
         /* f0 at round-off level: the contact opens now, at the step's end
          * (relocating to t f0/(f0 - f1) ~ 1e-16 t would repeat forever, as
          * the force stays at round-off) */

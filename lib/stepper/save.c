@@ -24,7 +24,9 @@ int odhs__st_save(odhs_stepper *st)
         if (f) st->sf = f;
         double *rs = odhs__realloc(st->srest, cap * sizeof *rs);
         if (rs) st->srest = rs;
-        if (!a || !b || !k || !f || !rs) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+        double *fr = odhs__realloc(st->fr, cap * sizeof *fr);
+        if (fr) st->fr = fr;
+        if (!a || !b || !k || !f || !rs || !fr) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
         st->scap = cap;
     }
     if (net->nwalls) {
@@ -108,6 +110,13 @@ void odhs__st_rollback(odhs_stepper *st)
     for (int a = 0; a < 3; ++a) st->M[3 * (a) + (a)] = 1.0;
 }
 
+void odhs__st_mark_start(odhs_stepper *st)
+{
+    if (st->net->nc) memcpy(st->fr, st->net->f, st->net->nc * sizeof *st->fr);
+    memcpy(st->Gr, st->G, sizeof st->Gr);
+    st->kappar = st->kappa;
+}
+
 /* back to the start of the current step before any contact changed (used by
  * the adaptive integrator to repeat a step with a shorter length) */
 int odhs__st_restart(odhs_stepper *st)
@@ -117,9 +126,9 @@ int odhs__st_restart(odhs_stepper *st)
     restore_clock(st);
     memcpy(st->disp, st->disps, st->nd * sizeof *st->disp);
     memcpy(st->M, st->Ms, sizeof st->M);
-    if (st->snc) memcpy(net->f, st->sf, st->snc * sizeof *net->f);
-    memcpy(st->G, st->Gs, sizeof st->G);
-    st->kappa = st->kappas;
+    if (st->snc) memcpy(net->f, st->fr, st->snc * sizeof *net->f);
+    memcpy(st->G, st->Gr, sizeof st->G);
+    st->kappa = st->kappar;
     odhs__net_geometry(net, st->sys);
     return odhs__st_external_forces(st);
 }

@@ -46,9 +46,7 @@ static int driver_update(odhs_stepper *st, step_undo *u, odhs_event *first, int 
     odhs__prop_switch(st->drv, st->time, st->lambda);
     if ((s = odhs__st_external_forces(st)) || (s = odhs__st_rewire(st))) return s;
     st->drv_version = st->drv->version;
-    /* without events the step starts from the re-solved forces and flow: a
-     * step the scheme repeats shorter returns to them, not to the old ones */
-    if (!st->nchg) return odhs__st_save(st);
+    if (!st->nchg) return ODHS_OK;
     st->nsteps++;
     *done = 1;
     return odhs__st_emit_events(st, first, stop);
@@ -153,6 +151,10 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     st->nchg = 0;
     if ((s = driver_update(st, &u, first, stop, &done))) return undo(st, &u, s);
     if (done) return ODHS_OK;
+    /* the step starts from the forces and flow now, re-solved if the driver
+     * changed: a step the scheme repeats shorter returns to them, a failed
+     * step to the state before the call */
+    odhs__st_mark_start(st);
     const odhs__step_type *type = odhs__step_type_find(st->integrator);
     odhs__step_plan p = {0};
     st->pred_ok = 0;

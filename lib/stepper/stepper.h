@@ -92,6 +92,10 @@ struct odhs_stepper {
     size_t *sci, *scj;
     int *skind;
     double *sf;
+    /* the step's start after a driver change was re-solved (step.c): what a
+     * step repeated shorter returns to (the snapshot above keeps the state
+     * before the call, for the rollback); fr has the capacity scap */
+    double *fr, Gr[9], kappar;
     double *srest;    /* rest lengths (copied only with permanent contacts) */
     odhs_wall *wsnap; /* walls at the snapshot */
     size_t wsnapcap;
@@ -220,6 +224,8 @@ int odhs__st_save(odhs_stepper *st);
 void odhs__st_restore_motion(odhs_stepper *st);
 /* the whole saved state back (a failed step) */
 void odhs__st_rollback(odhs_stepper *st);
+/* the forces and flow now are the step's start (odhs__st_restart) */
+void odhs__st_mark_start(odhs_stepper *st);
 /* back to the start of the step before any contact changed, with the
  * displacement record of the scheme's begin (a step repeated shorter) */
 int odhs__st_restart(odhs_stepper *st);
