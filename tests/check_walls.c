@@ -342,41 +342,45 @@ START_TEST(test_piston_solvers_agree)
 }
 END_TEST
 
-START_TEST(test_walls_checkpoint)
+/* Write a checkpoint of a at its time, run a to t_end, read the checkpoint
+ * into b (solver "cg") and run it to t_end: both must end bit for bit at the
+ * same positions. */
+static void checkpoint_continue(scene *a, double t_end, scene *b, const char *what)
 {
-    scene a;
-    piston_scene(&a, "cg");
-    CHECK_OK(odhs_stepper_run_until_time(a.st, 1.0));
     char path[] = "/tmp/odhs_walls_ckpt_XXXXXX";
     int fd = mkstemp(path);
     ck_assert(fd >= 0);
     close(fd);
-    CHECK_OK(odhs_checkpoint_write(a.st, path));
-    CHECK_OK(odhs_stepper_run_until_time(a.st, 3.0));
-    odhs_solver *sol;
-    odhs_system *sys;
-    odhs_driver *drv;
-    odhs_stepper *st;
+    CHECK_OK(odhs_checkpoint_write(a->st, path));
+    CHECK_OK(odhs_stepper_run_until_time(a->st, t_end));
     char err[256];
-    CHECK_OK(odhs_solver_create_by_name("cg", &sol));
-    ck_assert_msg(odhs_checkpoint_read(path, sol, &sys, &drv, &st, err, sizeof err) == ODHS_OK, "%s", err);
-    size_t nw;
-    CHECK_OK(odhs_stepper_wall_count(st, &nw));
-    ck_assert_uint_eq(nw, 2);
-    CHECK_OK(odhs_stepper_run_until_time(st, 3.0));
-    double xa[2 * NP], xb[2 * NP], da[2], db[2];
-    CHECK_OK(odhs_system_get_positions(a.sys, xa));
-    CHECK_OK(odhs_system_get_positions(sys, xb));
-    ck_assert_msg(!memcmp(xa, xb, sizeof xa), "continuation with walls is not bit-identical");
-    CHECK_OK(odhs_stepper_wall_displacement(a.st, 1, da));
-    CHECK_OK(odhs_stepper_wall_displacement(st, 1, db));
-    ck_assert(!memcmp(da, db, sizeof da));
-    odhs_stepper_destroy(st);
-    odhs_driver_destroy(drv);
-    odhs_system_destroy(sys);
-    odhs_solver_destroy(sol);
-    scene_free(&a);
+    memset(b, 0, sizeof *b);
+    CHECK_OK(odhs_solver_create_by_name("cg", &b->sol));
+    ck_assert_msg(odhs_checkpoint_read(path, b->sol, &b->sys, &b->drv, &b->st, err, sizeof err) == ODHS_OK, "%s",
+                  err);
     remove(path);
+    CHECK_OK(odhs_stepper_run_until_time(b->st, t_end));
+    double xa[2 * NP], xb[2 * NP];
+    CHECK_OK(odhs_system_get_positions(a->sys, xa));
+    CHECK_OK(odhs_system_get_positions(b->sys, xb));
+    ck_assert_msg(!memcmp(xa, xb, sizeof xa), "%s is not bit-identical", what);
+}
+
+START_TEST(test_walls_checkpoint)
+{
+    scene a, b;
+    piston_scene(&a, "cg");
+    CHECK_OK(odhs_stepper_run_until_time(a.st, 1.0));
+    checkpoint_continue(&a, 3.0, &b, "continuation with walls");
+    size_t nw;
+    CHECK_OK(odhs_stepper_wall_count(b.st, &nw));
+    ck_assert_uint_eq(nw, 2);
+    double da[2], db[2];
+    CHECK_OK(odhs_stepper_wall_displacement(a.st, 1, da));
+    CHECK_OK(odhs_stepper_wall_displacement(b.st, 1, db));
+    ck_assert(!memcmp(da, db, sizeof da));
+    scene_free(&b);
+    scene_free(&a);
 }
 END_TEST
 
@@ -385,7 +389,7 @@ END_TEST
  * wall was refused on reading), and a run with them continues bit for bit. */
 START_TEST(test_wall_contact_kind)
 {
-    scene a;
+    scene a, b;
     piston_scene(&a, "cg");
     CHECK_OK(odhs_stepper_run_until_time(a.st, 3.0));
     const odhs_network *net = odhs_stepper_network(a.st);
@@ -398,30 +402,9 @@ START_TEST(test_wall_contact_kind)
         nwall += j >= NP;
     }
     ck_assert_msg(nwall > 0, "no wall contact at t = 3");
-    char path[] = "/tmp/odhs_walls_kind_XXXXXX";
-    int fd = mkstemp(path);
-    ck_assert(fd >= 0);
-    close(fd);
-    CHECK_OK(odhs_checkpoint_write(a.st, path));
-    CHECK_OK(odhs_stepper_run_until_time(a.st, 5.0));
-    odhs_solver *sol;
-    odhs_system *sys;
-    odhs_driver *drv;
-    odhs_stepper *st;
-    char err[256];
-    CHECK_OK(odhs_solver_create_by_name("cg", &sol));
-    ck_assert_msg(odhs_checkpoint_read(path, sol, &sys, &drv, &st, err, sizeof err) == ODHS_OK, "%s", err);
-    CHECK_OK(odhs_stepper_run_until_time(st, 5.0));
-    double xa[2 * NP], xb[2 * NP];
-    CHECK_OK(odhs_system_get_positions(a.sys, xa));
-    CHECK_OK(odhs_system_get_positions(sys, xb));
-    ck_assert_msg(!memcmp(xa, xb, sizeof xa), "continuation after wall contacts is not bit-identical");
-    odhs_stepper_destroy(st);
-    odhs_driver_destroy(drv);
-    odhs_system_destroy(sys);
-    odhs_solver_destroy(sol);
+    checkpoint_continue(&a, 5.0, &b, "continuation after wall contacts");
+    scene_free(&b);
     scene_free(&a);
-    remove(path);
 }
 END_TEST
 
