@@ -1,5 +1,4 @@
 /* libodhs - drift correction (Sect. IV C of the paper). */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

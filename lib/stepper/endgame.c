@@ -1,6 +1,5 @@
 /* libodhs - the jamming end-game (Sect. IV D of the paper): polish, final
  * pivots, rattlers out of overlaps, f0 on the final geometry. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

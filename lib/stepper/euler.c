@@ -17,11 +17,3 @@ static int euler_plan(odhs_stepper *st, odhs__step_plan *p)
 /* default drift-correction interval: the paper's 10 steps (its straight
  * chords only open contact gaps, by O(dt^2)) */
 const odhs__step_type odhs__step_euler = {ODHS_INTEGRATOR_EULER, "euler", 10u, NULL, euler_plan, NULL, NULL, NULL};
-
-const odhs__step_type *odhs__step_type_find(int id)
-{
-    static const odhs__step_type *const types[] = {&odhs__step_euler, &odhs__step_heun};
-    for (size_t k = 0; k < sizeof types / sizeof types[0]; ++k)
-        if (types[k]->id == id) return types[k];
-    return NULL;
-}

@@ -1,5 +1,4 @@
 /* libodhs - the step's contact changes and the events they make. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,7 +1,6 @@
 /* libodhs - the stepper's forces and velocities on the current network:
  * external forces, the right-hand side of the affine flow, the force solve
  * (eqs. 11-12 and 18-19 of the paper) and pair velocities. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

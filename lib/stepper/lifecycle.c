@@ -1,5 +1,4 @@
 /* libodhs - the stepper handle: create, destroy, settings and reset. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,7 +1,5 @@
 /* libodhs - moving along a chord: positions, box and walls. */
-#include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "stepper/stepper.h"

@@ -1,6 +1,5 @@
 /* libodhs - the stepper's neighbour list (a Verlet list with a skin over the
  * cell search of lib/geom) and its check on a restored state. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

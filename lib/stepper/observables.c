@@ -1,6 +1,5 @@
 /* libodhs - observables of the stepper's state: stress (eq. 30), pressure
  * (eq. 24), power, velocities, counts, errors. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

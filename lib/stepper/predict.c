@@ -1,8 +1,6 @@
 /* libodhs - collision prediction (Sect. IV A (ii.a) of the paper): exact
  * contact times of pairs and of particles with walls on a straight chord. */
-#include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "stepper/stepper.h"

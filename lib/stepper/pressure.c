@@ -1,7 +1,6 @@
 /* libodhs - pressure control (Sect. II C of the paper): the forces and the
  * compression rate kappa at fixed pressure, on general and on isostatic
  * networks, and the drift correction of a flowing isostatic network. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

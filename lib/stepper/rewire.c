@@ -1,6 +1,5 @@
 /* libodhs - the rewiring (Sect. IV B of the paper) and its anti-cycling
  * fallback: the unique valid network after every event. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,9 +1,7 @@
 /* libodhs - one save of the state at the start of a step, and the two ways
  * back to it: the rollback of a failed step and the restart of a step the
  * integrator repeats shorter. */
-#include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "stepper/stepper.h"

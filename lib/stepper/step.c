@@ -1,10 +1,18 @@
 /* libodhs - one step (Sect. IV A of the paper) and the run loops. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "stepper/stepper.h"
+
+/* the integrators (step types) the library has */
+const odhs__step_type *odhs__step_type_find(int id)
+{
+    static const odhs__step_type *const types[] = {&odhs__step_euler, &odhs__step_heun};
+    for (size_t k = 0; k < sizeof types / sizeof types[0]; ++k)
+        if (types[k]->id == id) return types[k];
+    return NULL;
+}
 
 /* ---- one step (Sect. IV A) ----------------------------------------------- */
 /* What a failed step puts back besides the state saved by odhs__st_save. */

@@ -168,7 +168,7 @@ typedef struct {
 
 extern const odhs__step_type odhs__step_euler; /* euler.c: the paper's scheme */
 extern const odhs__step_type odhs__step_heun;  /* heun.c: adaptive Heun */
-/* the step type of ODHS_INTEGRATOR_* id, NULL if none */
+/* the step type of ODHS_INTEGRATOR_* id, NULL if none (step.c) */
 const odhs__step_type *odhs__step_type_find(int id);
 
 /* ---- forces.c: forces and velocities on the current network ---------------- */
