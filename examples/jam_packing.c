@@ -51,7 +51,7 @@ static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, do
 int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = NULL;
-    double dt = 1e-3, max_strain = 20.0, tol = 1e-6;
+    double dt = 1e-3, max_strain = 20.0, tol = 1e-6, p_jam = 0.0;
     int protocol = COMPRESS, integrator = ODHS_INTEGRATOR_HEUN, dim = 2;
     unsigned long corr = 1;
     unsigned long n = 256, seed = 1;
@@ -67,6 +67,10 @@ int main(int argc, char **argv)
         CLI_TOL(&tol),
         CLI_DT(&dt, "natural units"),
         CLI_OPT_DOUBLE("--max-strain", &max_strain, "X", "shear protocols: give up after this strain", CLI_POSITIVE),
+        CLI_OPT_DOUBLE("--jam-pressure", &p_jam, "P",
+                       "pressure protocol: a network with positive self-stress is jammed once the pressure is >= P "
+                       "(0: as soon as it appears; below P it flows by dilating)",
+                       CLI_NONNEGATIVE),
         CLI_OPT_ULONG("--correction", &corr, "K",
                       "drift correction every K steps; certified packings need contact gaps at round-off when they "
                       "jam",
@@ -79,7 +83,9 @@ int main(int argc, char **argv)
         "Protocols: compress = isotropic compression; shear = compress to jamming,\n"
         "dilate by 0.2% and shear at fixed volume until arrest; shear+compress =\n"
         "shear with compression at 1/5 of the shear rate; pressure = shear at fixed\n"
-        "pressure, doubled every 0.05 strain (towards zero strain rate).\n"
+        "pressure, doubled every 0.05 strain (towards zero strain rate); at a finite\n"
+        "pressure the flow would go on, so the run stops at the first network with\n"
+        "positive self-stress once p >= --jam-pressure (default 0: at once).\n"
         "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed\n"
         "or not certified (force balance < 1e-12, gaps < 1e-13, no overlap, all\n"
         "backbone forces > 0, isostatic).\n",
@@ -130,6 +136,7 @@ int main(int argc, char **argv)
     } else { /* pressure */
         odhs_driver_set_shear_rate(drv, 1.0);
         odhs_driver_set_pressure(drv, 1.0);
+        odhs_driver_set_jamming_pressure(drv, p_jam);
         rc = drive(st, drv, 1, 1, max_strain);
     }
     int status = 0;

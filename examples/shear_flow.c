@@ -28,6 +28,8 @@
 
 /* the --series columns */
 #define SERIES "strain,shear_stress,pressure,z,events"
+/* ... at fixed pressure: the two panels of the paper's Fig. 7 as well */
+#define SERIES_P "strain,shear_stress,pressure,z,events,phi,kappa"
 /* ... with --oscillate, and the --strobe columns */
 #define SERIES_OSC "time,strain,shear_stress,pressure,z,events"
 #define STROBE "cycle,strobe_rms,from_start,events"
@@ -180,12 +182,13 @@ static int run_oscillation(odhs_stepper *st, odhs_system *sys, const oscillation
 }
 
 /* the run at a constant rate to the strain target, an output every `every`;
- * 1 after an error (reported), 0 otherwise (also when it stopped, jammed) */
+ * 0 when it reached the target, 3 when it stopped before (jammed; the
+ * reason is reported), 1 after an error (reported) */
 static int run_strain(odhs_stepper *st, odhs_system *sys, double strain, double every, int fixed_p, FILE *csv)
 {
     int failed = 0;
     printf("%12s %14s %14s %8s %10s%s\n", "strain", "shear_stress", "pressure", "z", "events",
-           fixed_p ? "        phi" : "");
+           fixed_p ? "        phi          kappa" : "");
     double g0;
     odhs_stepper_strain(st, &g0);
     long nout = (long)ceil(strain / every - 1e-9);
@@ -194,29 +197,34 @@ static int run_strain(odhs_stepper *st, odhs_system *sys, double strain, double 
         if (k > 0) {
             int rc = odhs_stepper_run_until_strain(st, target);
             if (rc) {
-                fprintf(stderr, "shear_flow: stopped at strain %.6g: %s (%s)\n", target, odhs_strerror(rc),
-                        odhs_stepper_errmsg(st));
-                failed = rc < 0;
+                double g;
+                odhs_stepper_strain(st, &g);
+                fprintf(stderr, "\nshear_flow: stopped at strain %.6g of %.6g: %s (%s)\n", g - g0, strain,
+                        odhs_strerror(rc), odhs_stepper_errmsg(st));
+                failed = rc < 0 ? 1 : 3;
                 break;
             }
         }
-        double g, s, p, z;
+        double g, s, p, z, kappa;
         uint64_t steps, nc, no;
         odhs_stepper_strain(st, &g);
         odhs_stepper_shear_stress(st, &s);
         odhs_stepper_pressure(st, &p);
         odhs_stepper_coordination(st, &z);
+        odhs_stepper_kappa(st, &kappa);
         odhs_stepper_counts(st, &steps, &nc, &no);
         double phi_now;
         odhs_system_packing_fraction(sys, &phi_now);
-        if (fixed_p)
-            printf("%12.6f %14.6e %14.6e %8.4f %10llu %10.6f\n", g - g0, s, p, z,
-                   (unsigned long long)(nc + no), phi_now);
-        else
-            printf("%12.6f %14.6e %14.6e %8.4f %10llu\n", g - g0, s, p, z, (unsigned long long)(nc + no));
-        if (csv) fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu\n", g - g0, s, p, z, (unsigned long long)(nc + no));
+        unsigned long long ev = (unsigned long long)(nc + no);
+        if (fixed_p) {
+            printf("%12.6f %14.6e %14.6e %8.4f %10llu %10.6f %14.6e\n", g - g0, s, p, z, ev, phi_now, kappa);
+            if (csv) fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g\n", g - g0, s, p, z, ev, phi_now, kappa);
+        } else {
+            printf("%12.6f %14.6e %14.6e %8.4f %10llu\n", g - g0, s, p, z, ev);
+            if (csv) fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu\n", g - g0, s, p, z, ev);
+        }
         fprintf(stderr, "\rshear_flow: strain %.4f / %.4f, %llu steps, %llu events", g - g0, strain,
-                (unsigned long long)steps, (unsigned long long)(nc + no));
+                (unsigned long long)steps, ev);
     }
     fprintf(stderr, "\n");
     return failed;
@@ -235,7 +243,7 @@ int main(int argc, char **argv)
         CLI_STRAIN(&strain),
         CLI_OUT(&outpath),
         CLI_SVG(&svg),
-        CLI_SERIES(&series, SERIES),
+        CLI_SERIES(&series, SERIES "; with --pressure also phi,kappa"),
         CLI_EVERY(&every, "strain"),
         CLI_DT(&dt, "strain units"),
         CLI_INTEGRATOR(&integrator),
@@ -258,7 +266,11 @@ int main(int argc, char **argv)
     const cli_spec cli = {"shear_flow", NULL, opts,
                           "The default solver and integrator, cg and euler, are the paper's choices.\n"
                           "Forces are in units of lambda*gammadot/xi0 with lambda the small diameter;\n"
-                          "stresses in units of gammadot/xi0 (2D: per length, 3D: per area).\n",
+                          "stresses in units of gammadot/xi0 (2D: per length, 3D: per area).\n"
+                          "With --pressure P the volume follows the pressure (kappa: compression rate\n"
+                          "over shear rate, < 0 dilating) and the flow never stops at a finite P; the\n"
+                          "viscous number is I_v = 1/P. Exit status: 0 when the requested strain was\n"
+                          "reached, 3 when the run stopped before it (the reason on stderr), 1 on error.\n",
                           0};
     int rc = cli_parse(&cli, argc, argv);
     if (rc != CLI_GO) return rc;
@@ -301,7 +313,7 @@ int main(int argc, char **argv)
     }
 
     FILE *csv;
-    if (cli_series(cli.prog, series, oscillate ? SERIES_OSC : SERIES, &csv)) return 1;
+    if (cli_series(cli.prog, series, oscillate ? SERIES_OSC : pressure > 0 ? SERIES_P : SERIES, &csv)) return 1;
     int failed = oscillate ? run_oscillation(st, sys, &osc, csv) : run_strain(st, sys, strain, every, pressure > 0, csv);
     double gap, ov;
     odhs_stepper_errors(st, &gap, &ov);
@@ -329,5 +341,5 @@ int main(int argc, char **argv)
     odhs_driver_destroy(drv);
     odhs_solver_destroy(solver);
     odhs_system_destroy(sys);
-    return failed || rc < 0 ? 1 : 0;
+    return failed ? failed : rc < 0 ? 1 : 0;
 }

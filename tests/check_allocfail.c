@@ -743,8 +743,9 @@ static void edit_final(af_fix *f, const af_scenario *sc) { check_network(f->net,
  *    self-propulsion (short persistence: most steps end at a switch, whose
  *    redraw a failed step must undo) and gravity with weights, 4 Euler + cg
  *    capped at one iteration with a dense fallback (every solve goes through
- *    it). The driver also carries (zero) external forces, so that their code
- *    paths run too. */
+ *    it), 5 Heun + dense at p = 1e4 (isostatic networks flow). The
+ *    driver also carries (zero) external forces, so that their code paths
+ *    run too. */
 enum {
     SH_FORCES = 7,
     SH_RESET,
@@ -775,6 +776,9 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
     case 1: {
         int s = odhs_driver_set_shear_rate(f->drv, 1.0);
         if (!s && v == 2) s = odhs_driver_set_pressure(f->drv, 0.05);
+        /* 5: a high pressure: isostatic networks flow (the bordered solve,
+         * its sub-network, the sparse f0 and zero-pressure self-stress) */
+        if (!s && v == 5) s = odhs_driver_set_pressure(f->drv, 1e4);
         return s;
     }
     case 2:
@@ -794,11 +798,12 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
             f->sol2 = dn;
             return ODHS_OK;
         }
-        return odhs_solver_create_by_name(v == 1 || v == 3 ? "dense" : "cg", &f->sol);
+        return odhs_solver_create_by_name(v == 1 || v == 3 || v == 5 ? "dense" : "cg", &f->sol);
     case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
     case 4: return odhs_stepper_set_dt(f->st, 0.02);
     case 5:
-        return odhs_stepper_set_integrator(f->st, v == 1 || v == 3 ? ODHS_INTEGRATOR_HEUN : ODHS_INTEGRATOR_EULER);
+        return odhs_stepper_set_integrator(f->st, v == 1 || v == 3 || v == 5 ? ODHS_INTEGRATOR_HEUN
+                                                                             : ODHS_INTEGRATOR_EULER);
     case 6: return odhs_stepper_set_contact_tolerance(f->st, 1e-2);
     case SH_FORCES: {
         double F[64];
@@ -1300,6 +1305,7 @@ static const af_scenario scenarios[] = {
     {"shear_pressure", SH_NOPS, 2, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_propulsion", SH_NOPS, 3, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_cg_fallback", SH_NOPS, 4, shear_setup, NULL, shear_op, shear_capture, shear_final},
+    {"shear_pressure_high", SH_NOPS, 5, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"checkpoint", 3, 0, ckpt_setup, NULL, ckpt_op, ckpt_capture, ckpt_final},

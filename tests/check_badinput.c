@@ -326,7 +326,8 @@ static const char *probe_driver(const odhs_driver *a, const odhs_driver *b, cons
         odhs_driver_get_compression_rate(a, &va[1]) || odhs_driver_get_compression_rate(b, &vb[1]) ||
         odhs_driver_get_mobility(a, &va[2]) || odhs_driver_get_mobility(b, &vb[2]) ||
         odhs_driver_get_pressure(a, &va[3], &ea) || odhs_driver_get_pressure(b, &vb[3], &eb) ||
-        odhs_driver_time_unit(a, sys, &va[4]) || odhs_driver_time_unit(b, sys, &vb[4]) || ea != eb ||
+        odhs_driver_time_unit(a, sys, &va[4]) || odhs_driver_time_unit(b, sys, &vb[4]) ||
+        odhs_driver_get_jamming_pressure(a, &va[5]) || odhs_driver_get_jamming_pressure(b, &vb[5]) || ea != eb ||
         !bits_eq(va, vb, sizeof va)) {
         snprintf(msg, sizeof msg, "driver %s: settings changed or getters fail", name);
         return msg;
@@ -1424,6 +1425,16 @@ static int huge_rate_case(void)
       return odhs_driver_set_kappa_max(w->drv, NAN_);)                                                         \
     X(drv_kmax_zero, odhs_driver_set_kappa_max, ODHS_E_INVALID, NOALT, H_DRV, 0,                               \
       return odhs_driver_set_kappa_max(w->drv, 0.0);)                                                          \
+    X(drv_pjam_null, odhs_driver_set_jamming_pressure, ODHS_E_NULL, NOALT, H_NONE, 0,                          \
+      return odhs_driver_set_jamming_pressure(NULL, 1.0);)                                                     \
+    X(drv_pjam_nan, odhs_driver_set_jamming_pressure, ODHS_E_NONFINITE, NOALT, H_DRV, 0,                       \
+      return odhs_driver_set_jamming_pressure(w->drv, NAN_);)                                                  \
+    X(drv_pjam_negative, odhs_driver_set_jamming_pressure, ODHS_E_INVALID, NOALT, H_DRV, 0,                    \
+      return odhs_driver_set_jamming_pressure(w->drv, -1.0);)                                                  \
+    X(drv_get_pjam_null, odhs_driver_get_jamming_pressure, ODHS_E_NULL, NOALT, H_NONE, 0,                      \
+      double v; return odhs_driver_get_jamming_pressure(NULL, &v);)                                            \
+    X(drv_get_pjam_null_out, odhs_driver_get_jamming_pressure, ODHS_E_NULL, NOALT, H_DRV, 0,                   \
+      return odhs_driver_get_jamming_pressure(w->drv, NULL);)                                                  \
     X(drv_forces_null, odhs_driver_set_forces, ODHS_E_NULL, NOALT, H_NONE, 0,                                  \
       double F[32] = {0}; return odhs_driver_set_forces(NULL, 16, 2, F);)                                      \
     X(drv_forces_dim1, odhs_driver_set_forces, ODHS_E_DIM, NOALT, H_DRV, 0,                                    \

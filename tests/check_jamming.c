@@ -798,6 +798,8 @@ static void jrun_configure(jrun *r)
     } else if (!strcmp(r->protocol, "pressure")) {
         CHECK_OK(odhs_driver_set_shear_rate(drv, 1.0));
         CHECK_OK(odhs_driver_set_pressure(drv, 1.0));
+        /* jam_packing's default --jam-pressure 0: the protocol's p -> inf */
+        CHECK_OK(odhs_driver_set_jamming_pressure(drv, 0.0));
     } else {
         ck_abort_msg("unknown protocol %s", r->protocol);
     }
@@ -1031,15 +1033,18 @@ END_TEST
 /* The final pivots and the rattlers after the polish                         */
 /* ========================================================================== */
 /*
- * Fixed pressure, 2D N = 64, seeds 9 and 14 (jam_packing --protocol pressure
+ * Fixed pressure, 2D N = 64, seeds 9 and 46 (jam_packing --protocol pressure
  * --n 64 --seed 9): version 0.2.2 returned packings with a pair outside the
- * network 9.7e-14 and 8.5e-14 inside contact after the polish (seed 9: two
- * backbone discs; seed 14: a backbone disc and a rattler with two contacts).
- * Each needs exactly the one pivot that takes the pair in.
+ * network 9.7e-14 inside contact after the polish (seed 9: two backbone
+ * discs; seed 14 then had a backbone disc and a rattler with two contacts).
+ * Each needs exactly the one pivot that takes the pair in. Since 0.2.5 the
+ * pressure forces are solved through the bordered system (pressure.c) and
+ * seed 14 no longer needs one; of seeds 1-70 (all certified) seeds 9 and 46
+ * do.
  */
 static const jam_case pivot_cases[] = {
     {2, 64, 9, "pressure"},
-    {2, 64, 14, "pressure"},
+    {2, 64, 46, "pressure"},
 };
 
 START_TEST(test_pivot_certified)
@@ -1519,6 +1524,7 @@ START_TEST(test_pressure_isostatic_flow)
     jrun_start(&r, 2, 64, seed, "pressure", "default");
     CHECK_OK(odhs_driver_set_shear_rate(r.drv, 1.0));
     CHECK_OK(odhs_driver_set_pressure(r.drv, 1.0));
+    CHECK_OK(odhs_driver_set_jamming_pressure(r.drv, 0.0));
     size_t n = r.n, nd = 2 * n;
     double *U = xcalloc(nd, sizeof *U), *F = xcalloc(nd, sizeof *F), *rad = xcalloc(n, sizeof *rad);
     CHECK_OK(odhs_system_get_radii(r.sys, rad));

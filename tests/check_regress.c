@@ -577,6 +577,7 @@ static void jam_scene(int dim, size_t n, uint64_t seed, const char *solver, int 
     case JAM_PRESSURE:
         OK(odhs_driver_set_shear_rate(s.drv, 1.0));
         OK(odhs_driver_set_pressure(s.drv, 1.0));
+        OK(odhs_driver_set_jamming_pressure(s.drv, 0.0)); /* jam_packing's default */
         jam_drive_shear(&s, 1, 3.0);
         break;
     }

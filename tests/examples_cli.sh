@@ -40,7 +40,11 @@ expect 0 "shear_flow from a file" -- "$bin/shear_flow" --in "$tmp/c.xyz" --strai
     --out "$tmp/s.xyz" --series "$tmp/s.csv"
 expect_in s.csv "^strain,shear_stress,pressure,z,events" "shear_flow writes its series header"
 [ "$(wc -l < "$tmp/s.csv")" -eq 4 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow series rows"; fail=$((fail + 1)); }
-expect 0 "shear_flow at fixed pressure" -- "$bin/shear_flow" --in "$tmp/s.xyz" --strain 0.01 --pressure 5
+expect 0 "shear_flow at fixed pressure" -- "$bin/shear_flow" --in "$tmp/s.xyz" --strain 0.01 --pressure 5 \
+    --series "$tmp/p.csv"
+expect_in p.csv "^strain,shear_stress,pressure,z,events,phi,kappa$" "shear_flow --pressure series has phi and kappa"
+expect_in out "phi          kappa" "shear_flow --pressure table has phi and kappa"
+[ "$(awk -F, 'NR > 1 && NF != 7' "$tmp/p.csv" | wc -l)" -eq 0 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --pressure rows have 7 fields"; fail=$((fail + 1)); }
 expect 0 "shear_flow svg" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --svg "$tmp/s.svg"
 head -c 4 "$tmp/s.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: shear_flow svg"; fail=$((fail + 1)); }
 grep -q "<line" "$tmp/s.svg" && pass=$((pass + 1)) || { echo "FAIL: shear_flow svg has no force lines"; fail=$((fail + 1)); }
@@ -79,6 +83,10 @@ expect 2 "jam_packing bad protocol" -- "$bin/jam_packing" --protocol squash
 expect 0 "jam_packing compress" -- "$bin/jam_packing" --n 32 --svg "$tmp/j.svg" --contacts "$tmp/j.con" --out "$tmp/j.xyz"
 expect_in out "jammed                 yes" "jam_packing certifies a jammed packing"
 head -c 4 "$tmp/j.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: jam_packing svg"; fail=$((fail + 1)); }
+# a jammed packing sheared at fixed volume stops at once: exit 3 with the reason
+expect 3 "shear_flow on a jammed packing stops early" -- "$bin/shear_flow" --in "$tmp/j.xyz" --strain 0.1 --solver dense
+expect_in err "^shear_flow: stopped at strain" "shear_flow says why it stopped, on a line of its own"
+expect 2 "jam_packing negative --jam-pressure" -- "$bin/jam_packing" --jam-pressure -1
 grep -q "^# libodhs contacts" "$tmp/j.con" && pass=$((pass + 1)) || { echo "FAIL: jam_packing contacts"; fail=$((fail + 1)); }
 expect 0 "composite help" -- "$bin/composite" --help
 expect_in out "usage: composite" "composite --help prints usage"

@@ -22,7 +22,8 @@
  * field and weights), and since 0.2.2 DRVC (the driver was changed after
  * the forces were solved: the restored stepper re-solves them at its next
  * step, as the original would have), and since 0.2.4 OSC (oscillatory shear:
- * shape, amplitude, period, phase origin). A checkpoint that needs none of
+ * shape, amplitude, period, phase origin), and since 0.2.5 PJAM (a finite
+ * jamming pressure, odhs_driver_set_jamming_pressure). A checkpoint that needs none of
  * them is still written as version 1, so older releases read it; this library
  * reads both.
  * Writes go to a temporary file in the same directory that is flushed, synced

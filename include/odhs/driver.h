@@ -119,13 +119,31 @@ ODHS_API int odhs_driver_set_compression_rate(odhs_driver *drv, double c);
  * Shear at fixed pressure p > 0 (requires a nonzero shear rate and no
  * compression rate when stepping). kappa is clamped to [-kappa_max,
  * kappa_max] (default 100), which only matters when the contacts cannot carry
- * the pressure (for example when there are none).
+ * the pressure (for example when there are none). The flow never stops at a
+ * finite p unless p >= the jamming pressure (odhs_driver_set_jamming_pressure).
  */
 ODHS_API int odhs_driver_set_pressure(odhs_driver *drv, double p);
 /** Turn pressure control off (back to fixed volume). */
 ODHS_API int odhs_driver_clear_pressure(odhs_driver *drv);
 /** Bound on |kappa| under pressure control (> 0). */
 ODHS_API int odhs_driver_set_kappa_max(odhs_driver *drv, double kappa_max);
+/**
+ * Jamming pressure p_jam (>= 0, +INFINITY allowed; default +INFINITY) under
+ * pressure control. An isostatic network (one self-stress f0 on the
+ * constrained subset) whose f0 is positive on every contact that can open
+ * can still flow at fixed pressure: the volume is one more degree of
+ * freedom, so it dilates or compacts with kappa set by the geometry and the
+ * forces f = f_reg + alpha f0 carry p. With p < p_jam the stepper lets it
+ * flow (the physics of shear at a finite pressure, docs/guide.md section 6);
+ * with p >= p_jam it stops there as jammed (ODHS_JAMMED with a certificate),
+ * the limit p -> infinity that a jamming protocol (pressure raised without
+ * bound, as jam_packing --protocol pressure does) stands for. p_jam = 0 is
+ * the rule of libodhs <= 0.2.4: jammed whenever such a network appears.
+ * Errors: ODHS_E_NULL, ODHS_E_NONFINITE (NaN), ODHS_E_INVALID (< 0).
+ */
+ODHS_API int odhs_driver_set_jamming_pressure(odhs_driver *drv, double p_jam);
+/** The jamming pressure (see odhs_driver_set_jamming_pressure). */
+ODHS_API int odhs_driver_get_jamming_pressure(const odhs_driver *drv, double *p_jam);
 /** Fixed external forces F[0..n*dim-1] (copied); F == NULL removes them.
  *  Replaces any force callback. */
 ODHS_API int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const double *F);

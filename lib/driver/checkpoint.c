@@ -1,7 +1,8 @@
 /* libodhs - the driver's checkpoint sections (include/odhs/checkpoint.h,
  * lib/io/ckpt.h): DRV (flow, pressure, fixed forces), and after the contacts
  * the optional PROP (self-propulsion), GRAV (gravity), DRVC (the driver
- * changed after the forces were solved) and OSC (oscillatory shear).
+ * changed after the forces were solved), OSC (oscillatory shear) and PJAM
+ * (a finite jamming pressure).
  *
  * A new optional section of the driver: write it in
  * odhs__ckpt_write_driver_tail (returning 2, the format version it needs) and
@@ -104,7 +105,12 @@ unsigned odhs__ckpt_write_driver_tail(odhs__wbuf *b, const odhs__ckpt_out *o)
         odhs__put_f64(b, drv->osc_period);
         odhs__put_f64(b, drv->osc_t0);
     }
-    return drv->prop_on || drv->grav_on || o->drv_stale || drv->osc_shape ? 2u : 1u;
+    int pjam = !isinf(drv->p_jam); /* the default +INFINITY writes nothing */
+    if (pjam) {
+        odhs__put_tag(b, "PJAM");
+        odhs__put_f64(b, drv->p_jam);
+    }
+    return drv->prop_on || drv->grav_on || o->drv_stale || drv->osc_shape || pjam ? 2u : 1u;
 }
 
 /* the readers of the optional sections: 1 read, 0 read before, or an error */
@@ -187,10 +193,23 @@ static int read_osc(odhs__ckpt_in *in)
     return 1;
 }
 
+/* the jamming pressure: >= 0 and finite (the default, +INFINITY, is not
+ * written) */
+static int read_pjam(odhs__ckpt_in *in)
+{
+    odhs_driver *drv = in->drv;
+    if (!isinf(drv->p_jam)) return 0;
+    double pj = odhs__get_f64(&in->b);
+    if (in->b.bad || !isfinite(pj) || !(pj >= 0.0))
+        return odhs__ckpt_bad(in, "checkpoint: jamming pressure section malformed");
+    drv->p_jam = pj;
+    return 1;
+}
+
 static const struct {
     char tag[5];
     int (*read)(odhs__ckpt_in *in);
-} tail[] = {{"PROP", read_prop}, {"GRAV", read_grav}, {"DRVC", read_drvc}, {"OSC ", read_osc}};
+} tail[] = {{"PROP", read_prop}, {"GRAV", read_grav}, {"DRVC", read_drvc}, {"OSC ", read_osc}, {"PJAM", read_pjam}};
 
 int odhs__ckpt_read_driver_tail(odhs__ckpt_in *in, const char *tag)
 {

@@ -25,6 +25,7 @@ int odhs_driver_create(odhs_driver **out)
     if (!d) return ODHS_E_NOMEM;
     d->xi0 = 1.0;
     d->kappa_max = 100.0;
+    d->p_jam = INFINITY;
     return ODHS_OK;
 }
 
@@ -98,6 +99,24 @@ int odhs_driver_set_kappa_max(odhs_driver *drv, double kappa_max)
     if (!(kappa_max > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "kappa_max must be > 0");
     drv->kappa_max = kappa_max;
     drv->version++;
+    return ODHS_OK;
+}
+
+int odhs_driver_set_jamming_pressure(odhs_driver *drv, double p_jam)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (isnan(p_jam)) return odhs__drverr(drv, ODHS_E_NONFINITE, "jamming pressure is NaN");
+    if (!(p_jam >= 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "jamming pressure must be >= 0");
+    drv->p_jam = p_jam;
+    drv->version++;
+    return ODHS_OK;
+}
+
+int odhs_driver_get_jamming_pressure(const odhs_driver *drv, double *p_jam)
+{
+    if (!drv) return ODHS_E_NULL;
+    if (!p_jam) return odhs__drverr(drv, ODHS_E_NULL, "NULL argument");
+    *p_jam = drv->p_jam;
     return ODHS_OK;
 }
 

@@ -16,6 +16,7 @@ struct odhs_driver {
     int pressure_on;
     double p;
     double kappa_max;
+    double p_jam;      /* jamming pressure (INFINITY: flow at every p) */
     double *F;         /* fixed forces or NULL */
     size_t Fn;
     int Fdim;

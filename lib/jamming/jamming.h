@@ -19,5 +19,11 @@ int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, 
  * contacts, max |fs| = 1, sign undetermined; by the SVD of that matrix
  * (lib/jamming.c) */
 int odhs__null_vector_volume(const odhs_network *net, double *fs);
+/* the right singular vector of S^T (constrained subset) for its smallest
+ * singular value, with max |y| = 1, whether or not the contact count shows a
+ * self-stress: the near-kernel of a network whose N is singular or nearly so
+ * (the dense SVD, always; a rare fallback). ODHS_E_SINGULAR when that
+ * singular value is not separated from the next. */
+int odhs__null_vector_any(const odhs_network *net, double *y);
 
 #endif /* ODHS_JAMMING_JAMMING_H */

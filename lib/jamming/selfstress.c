@@ -254,3 +254,30 @@ done:
     odhs__free(full);
     return st;
 }
+
+int odhs__null_vector_any(const odhs_network *net, double *out)
+{
+    size_t *idx = NULL, m = 0;
+    int st = subset_contacts(net, &idx, &m);
+    if (st) return odhs__neterr(net, st, "out of memory");
+    double *y = odhs__malloc_array(m + 1, sizeof *y);
+    if (!y) {
+        odhs__free(idx);
+        return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    }
+    st = m < 2 ? ODHS_E_SINGULAR : null_dense(net, idx, m, NULL, y);
+    double big = 0.0;
+    if (!st) {
+        for (size_t a = 0; a < m; ++a) big = fmax(big, fabs(y[a]));
+        if (!(big > 0.0)) st = ODHS_E_SINGULAR;
+    }
+    if (!st) {
+        memset(out, 0, net->nc * sizeof *out);
+        for (size_t a = 0; a < m; ++a) out[idx[a]] = y[a] / big;
+    } else {
+        st = odhs__neterr(net, st, "near-kernel of S^T: %s", odhs_strerror(st));
+    }
+    odhs__free(idx);
+    odhs__free(y);
+    return st;
+}

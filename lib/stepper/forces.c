@@ -141,8 +141,11 @@ int odhs__st_compute_forces(odhs_stepper *st)
 void odhs__st_compute_velocities(odhs_stepper *st)
 {
     double xi0 = st->drv->xi0;
-    /* freg: alpha f0 is a self-stress, and alpha may be huge */
+    /* bordered (pressure.c): S^T f = S^T freg + f_k res exactly, without the
+     * cancellation of a huge f_k against the rest */
     odhs__net_ST(st->net, st->pj_bordered ? st->fpj + st->net->nc : st->net->f, st->U);
+    if (st->pj_bordered)
+        for (size_t k = 0; k < st->nd; ++k) st->U[k] += st->pj_alpha * st->pj_res[k];
     for (size_t k = 0; k < st->nd; ++k) st->U[k] = xi0 * (st->U[k] + (st->has_F ? st->F[k] : 0.0));
 }
 

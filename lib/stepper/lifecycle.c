@@ -36,6 +36,7 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->h = st->dt;
     st->corr_every = odhs__step_heun.corr_default;
     st->contact_tol = 1e-9;
+    st->iso_ci = st->iso_cj = SIZE_MAX;
     st->F = odhs__calloc(st->nd, sizeof(double));
     st->U = odhs__calloc(st->nd, sizeof(double));
     st->tmp = odhs__calloc(st->nd, sizeof(double));
@@ -62,7 +63,8 @@ void odhs_stepper_destroy(odhs_stepper *st)
 {
     if (!st) return;
     odhs_network_destroy(st->net);
-    void *arrays[] = {st->disps, st->U0, st->Ua, st->Up, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
+    odhs_network_destroy(st->iso_sub);
+    void *arrays[] = {st->pj_res, st->disps, st->U0, st->Ua, st->Up, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
                       st->rem, st->fpj, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->fr, st->srest, st->ev, st->wsnap};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);

@@ -106,7 +106,10 @@ static double predict_walls(const odhs_stepper *st, const double *G, const doubl
 
 /* ---- collision prediction ------------------------------------------------ */
 /* earliest time in [0, horizon] at which a non-contact pair touches when
- * separations move as d + t (G d + vel_j - vel_i) */
+ * separations move as d + t (G d + vel_j - vel_i). A touching pair counts
+ * when it approaches on the chord (current = 0), in the current velocities
+ * (1), or in either (2: the caller's scheme repeats a step whose chord
+ * disagrees with the current velocities). */
 double odhs__st_predict(const odhs_stepper *st, const double *G, const double *vel, double horizon,
                       double vtol, int moving, int current, size_t *pi, size_t *pj)
 {
@@ -142,7 +145,11 @@ double odhs__st_predict(const odhs_stepper *st, const double *G, const double *v
             if (!current) {
                 if (-b <= vtol * sqrt(dd)) continue;
             } else if (odhs__st_pair_velocity(st, i, j) >= -vtol) {
-                continue;
+                /* current = 2 (a scheme with an `early` hook): separating
+                 * now but closing along the chord is reported too, and the
+                 * scheme shortens the step (heun_early) until the chord
+                 * agrees; else it would overlap along the chord. */
+                if (current < 2 || -b <= vtol * sqrt(dd)) continue;
             }
             t = 0.0;
         } else {

@@ -7,10 +7,12 @@
 #include "stepper/stepper.h"
 
 /* Forces for the rewiring: on a potentially jammed network (*pj = 1 on
- * return) the self-stress f0 (Sect. IV D); under fixed pressure, where the
- * volume can still change, f0 only when it is positive (jammed at this
- * volume), else the forces of the flowing isostatic network (*pj = 0). A
- * failed f0 is ODHS_POTENTIALLY_JAMMED (or ODHS_E_NOMEM). */
+ * return) the self-stress f0 (Sect. IV D). Under fixed pressure the volume
+ * is one more degree of freedom: an isostatic network flows (*pj = 0, the
+ * bordered forces of pressure.c) unless p >= the jamming pressure and f0 is
+ * positive (jammed, *pj = 1); with one contact more it has the zero-pressure
+ * self-stress as its direction (*pj = 1). A failed f0 is
+ * ODHS_POTENTIALLY_JAMMED (or ODHS_E_NOMEM). */
 static int rewire_forces(odhs_stepper *st, int *pj)
 {
     odhs_network *net = st->net;
@@ -27,8 +29,17 @@ static int rewire_forces(odhs_stepper *st, int *pj)
                          st->time, net->errmsg);
         return ODHS_OK;
     }
-    /* kept in st->fpj for the forces of the flowing network below */
-    if ((s = odhs__st_isostatic_f0(st))) return s;
+    if ((s = odhs__st_isostatic_f0(st))) {
+        if (s == ODHS_E_NOMEM) return s;
+        /* no unique f0: two self-stresses beside a floppy mode, and one of
+         * their combinations carries no pressure: over-constrained, as one
+         * contact more than isostatic */
+        return odhs__st_pressure_open_direction(st);
+    }
+    if (st->drv->p < st->drv->p_jam) {
+        *pj = 0;
+        return odhs__st_compute_forces(st);
+    }
     memcpy(net->f, st->fpj, net->nc * sizeof *net->f);
     double fmax = 0.0;
     for (size_t c = 0; c < net->nc; ++c) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);

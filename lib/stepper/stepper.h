@@ -45,6 +45,7 @@ struct odhs_stepper {
     uint64_t nrejected, nsolves_pred;
     uint64_t work_pressure; /* pressure-control solves (odhs_stepper_feature_work) */
     unsigned corr_every;
+    int corr_skipped;  /* the last drift correction waited for the rewiring (correct.c) */
     double contact_tol;
     odhs_event_fn evfn;
     void *evctx;
@@ -74,11 +75,20 @@ struct odhs_stepper {
     int rewire_mode;            /* 0: paper's rule, anti-cycling takeover; 1: anti-cycling only (tests) */
     uint64_t nrewire_monotone;  /* rewirings the anti-cycling method finished (not checkpointed) */
     uint64_t njam_pivots;       /* pivots of jam_finish on the final packing (not checkpointed) */
-    /* fixed pressure on a potentially jammed network: net->f = freg + alpha f0
-     * with f0 then freg in fpj (2 nc); pj_bordered while net->f is of that form */
+    /* fixed pressure through the network without contact iso_k (pressure.c):
+     * scratch vectors in fpj (f0 and freg first, nc each); pj_bordered while
+     * the velocities are S^T freg + pj_alpha pj_res (res: nd, then nd of
+     * scratch) */
     double *fpj;
     size_t fpjcap;
-    uint64_t fpj_version; /* net->version of the f0 in fpj (0: none) */
+    uint64_t fpj_version;       /* net->version of the f0 in fpj (0: none) */
+    uint64_t iso_sub_version;   /* net->version of iso_sub */
+    uint64_t iso_basis_version; /* net->version of the basis (u, w, res) for iso_k */
+    odhs_network *iso_sub;      /* the network without contact iso_k */
+    size_t iso_k, iso_ci, iso_cj; /* that contact and its pair (iso_ci SIZE_MAX: none) */
+    double *pj_res;
+    size_t pj_rescap;
+    double pj_alpha;
     int pj_bordered;
     odhs_change *chg;
     size_t nchg, chgcap;
@@ -197,10 +207,16 @@ int odhs__st_add_contact(odhs_stepper *st, size_t i, size_t j, size_t *c);
 /* ---- pressure.c: fixed pressure -------------------------------------------- */
 /* the forces (net->f), kappa and G at fixed pressure */
 int odhs__st_pressure_forces(odhs_stepper *st);
+/* the self-stress at zero pressure h of a network with one contact more
+ * than isostatic (S^T h = 0, <r|h> = 0, max |h| = 1, sign undetermined):
+ * by sparse solves, else the dense SVD; ODHS_POTENTIALLY_JAMMED when neither
+ * finds a unique one */
+int odhs__st_zero_pressure_stress(odhs_stepper *st, double *h);
 /* the zero-pressure self-stress of a network with one contact more than
  * isostatic, signed against the driving, into net->f */
 int odhs__st_pressure_open_direction(odhs_stepper *st);
-int odhs__st_solve_isostatic(odhs_stepper *st, const double *f0, double *rhs, double *x, double tol);
+/* the self-stress f0 of an isostatic network into st->fpj (max |f0| = 1,
+ * sum > 0), and the bordered basis for its largest contact st->iso_k */
 int odhs__st_isostatic_f0(odhs_stepper *st);
 int odhs__st_correct_isostatic(odhs_stepper *st, double *Z);
 
