@@ -169,14 +169,13 @@ static void f0_normalise(odhs_stepper *st)
 static int f0_from_basis(odhs_stepper *st, size_t k)
 {
     size_t nc = st->net->nc;
-    double *f0 = fpj_vec(st, FPJ_F0), *w = fpj_vec(st, FPJ_W), big = 1.0, rmax = 0.0;
-    for (size_t x = 0; x < nc - 1; ++x) {
-        f0[x < k ? x : x + 1] = -w[x];
-        big = fmax(big, fabs(w[x]));
-    }
-    f0[k] = 1.0;
+    double *w = fpj_vec(st, FPJ_W), big = 1.0, rmax = 0.0;
+    for (size_t x = 0; x < nc - 1; ++x) big = fmax(big, fabs(w[x]));
     for (size_t a = 0; a < st->nd; ++a) rmax = fmax(rmax, fabs(st->pj_res[a]));
     if (!(rmax <= 1e-9 * big) || !(big <= 1e3)) return ODHS_E_SINGULAR;
+    double *f0 = fpj_vec(st, FPJ_F0);
+    for (size_t x = 0; x < nc - 1; ++x) f0[x < k ? x : x + 1] = -w[x];
+    f0[k] = 1.0;
     f0_normalise(st);
     return ODHS_OK;
 }
@@ -199,20 +198,26 @@ int odhs__st_isostatic_f0(odhs_stepper *st)
     if (k == SIZE_MAX) k = nc - 1;
     s = bordered_basis(st, k);
     if (s == ODHS_E_NOMEM) return s;
-    if (!s) s = f0_from_basis(st, k);
-    if (s) {
-        double *f0 = fpj_vec(st, FPJ_F0);
-        if ((s = odhs__null_vector(net, st->sol, f0, NULL)))
+    int from_k = !s && !f0_from_basis(st, k); /* f0 is the basis of k's */
+    if (!from_k) {
+        if ((s = odhs__null_vector(net, st->sol, fpj_vec(st, FPJ_F0), NULL)))
             return odhs__sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED,
                                "isostatic network at t = %.17g: %s", st->time, net->errmsg);
         f0_normalise(st);
     }
-    /* the basis for the largest |f0| (best conditioned N_k; kept if k) */
+    /* the basis of the largest |f0| (the best conditioned N_k), and f0 from
+     * that basis: the result does not depend on the guess (a restored
+     * checkpoint, which has none, continues bit for bit) */
     const double *f0 = fpj_vec(st, FPJ_F0);
-    size_t kmax = 0;
-    for (size_t c = 1; c < nc; ++c)
-        if (fabs(f0[c]) > fabs(f0[kmax])) kmax = c;
-    if ((s = bordered_basis(st, kmax))) return s;
+    for (int it = 0; it < 3; ++it) {
+        size_t kmax = 0;
+        for (size_t c = 1; c < nc; ++c)
+            if (fabs(f0[c]) > fabs(f0[kmax])) kmax = c;
+        if (from_k && kmax == k) break;
+        if ((s = bordered_basis(st, kmax))) return s;
+        k = kmax;
+        if (!(from_k = !f0_from_basis(st, k))) break; /* keep the f0 we have */
+    }
     st->fpj_version = net->version;
     return ODHS_OK;
 }
