@@ -190,8 +190,9 @@ static int heun_plan(odhs_stepper *st, odhs__step_plan *p)
 {
     memcpy(p->G, st->G, sizeof p->G);
     /* not under fixed pressure: there the interpolated predictor left
-     * contact gaps of ~1e-10 after a collision step at p = 1e4 (the full
-     * predictor: 1e-13, at the same cost in steps) */
+     * contact gaps of ~1e-10 after collision steps at p = 1e4, N = 64 (with
+     * the full predictor: below 1e-13 on all but one step over strain 0.05,
+     * at the same number of steps) */
     if (p->relocated && st->pred_ok && p->limit < st->taup && !st->drv->pressure_on) {
         heun_shorter(st, p->limit, p->G);
         p->tplan = p->limit;
