@@ -269,8 +269,10 @@ int main(int argc, char **argv)
                           "stresses in units of gammadot/xi0 (2D: per length, 3D: per area).\n"
                           "With --pressure P the volume follows the pressure (kappa: compression rate\n"
                           "over shear rate, < 0 dilating) and the flow never stops at a finite P; the\n"
-                          "viscous number is I_v = 1/P. Exit status: 0 when the requested strain was\n"
-                          "reached, 3 when the run stopped before it (the reason on stderr), 1 on error.\n",
+                          "viscous number is I_v = 1/P. With --pressure, cg hands the solves it cannot\n"
+                          "do (near isostatic networks) to auto. Exit status: 0 when the requested\n"
+                          "strain was reached, 3 when the run stopped before it (the reason on stderr),\n"
+                          "1 on error.\n",
                           0};
     int rc = cli_parse(&cli, argc, argv);
     if (rc != CLI_GO) return rc;
@@ -285,8 +287,15 @@ int main(int argc, char **argv)
         return 2;
     }
 
-    odhs_solver *solver;
+    odhs_solver *solver, *rescue = NULL;
     if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
+    if (pressure > 0 && !strcmp(solver_name, "cg")) {
+        /* at fixed pressure the flow passes through (nearly) isostatic
+         * networks, where CG alone does not converge: the solves it fails go
+         * to the automatic choice (odhs_solver_set_fallback) */
+        CHECK(odhs_solver_create_by_name("auto", &rescue));
+        CHECK(odhs_solver_set_fallback(solver, rescue));
+    }
 
     odhs_system *sys = NULL;
     if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, solver, &sys)) return 1;
@@ -340,6 +349,7 @@ int main(int argc, char **argv)
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(solver);
+    odhs_solver_destroy(rescue);
     odhs_system_destroy(sys);
     return failed ? failed : rc < 0 ? 1 : 0;
 }

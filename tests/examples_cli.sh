@@ -43,6 +43,8 @@ expect_in s.csv "^strain,shear_stress,pressure,z,events" "shear_flow writes its 
 expect 0 "shear_flow at fixed pressure" -- "$bin/shear_flow" --in "$tmp/s.xyz" --strain 0.01 --pressure 5 \
     --series "$tmp/p.csv"
 expect_in p.csv "^strain,shear_stress,pressure,z,events,phi,kappa$" "shear_flow --pressure series has phi and kappa"
+expect 0 "shear_flow --pressure 1000 with the default cg (auto rescues it)" -- "$bin/shear_flow" --n 48 \
+    --pressure 1000 --strain 0.02
 expect_in out "phi          kappa" "shear_flow --pressure table has phi and kappa"
 [ "$(awk -F, 'NR > 1 && NF != 7' "$tmp/p.csv" | wc -l)" -eq 0 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --pressure rows have 7 fields"; fail=$((fail + 1)); }
 expect 0 "shear_flow svg" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --svg "$tmp/s.svg"
