@@ -332,7 +332,7 @@ check-allocfail: deps-if-missing
 	    TEST_ENV="$(ALLOCFAIL_TEST_ENV)"
 
 # Shear at fixed pressure to strain 2 (the rheology suite at the strain of
-# issue 17; make check runs it to 0.1). About 45 min on one core.
+# issue 17; make check runs it to 0.1). 26 CPU minutes (2026-12-02).
 .PHONY: check-rheology
 check-rheology: deps-if-missing
 	@$(MAKE) --no-print-directory check-run \
