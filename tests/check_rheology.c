@@ -437,7 +437,8 @@ START_TEST(test_checkpoint_continues)
     OK(odhs_stepper_counts(a.st, &s1, &c1, &o1));
     OK(odhs_stepper_counts(st2, &s2, &c2, &o2));
     int same = !memcmp(x1, x2, 2 * n * sizeof *x1);
-    fprintf(stderr, "[rheology] checkpoint at p = 1000: %ld steps after it (%ld isostatic), positions %s, events %llu / %llu\n",
+    fprintf(stderr,
+            "[rheology] checkpoint at p = 1000: %ld steps after it (%ld isostatic), positions %s, events %llu / %llu\n",
             r.steps, r.iso_steps, same ? "bit-identical" : "DIFFER", (unsigned long long)(c1 + o1),
             (unsigned long long)(c2 + o2));
     free(x1);

@@ -64,8 +64,10 @@ void odhs_stepper_destroy(odhs_stepper *st)
     if (!st) return;
     odhs_network_destroy(st->net);
     odhs_network_destroy(st->iso_sub);
-    void *arrays[] = {st->pj_res, st->disps, st->U0, st->Ua, st->Up, st->F,   st->U,   st->tmp, st->cb,  st->cx,    st->pi,  st->pj, st->disp,
-                      st->rem, st->fpj, st->chg, st->xs, st->sci, st->scj, st->skind, st->sf, st->fr, st->srest, st->ev, st->wsnap};
+    void *arrays[] = {st->disps, st->U0,  st->Ua,    st->Up, st->F,  st->U,     st->tmp,   st->cb,
+                      st->cx,    st->pi,  st->pj,    st->disp, st->rem, st->fpj,  st->pj_res, st->chg,
+                      st->xs,    st->sci, st->scj,   st->skind, st->sf, st->fr,   st->srest, st->ev,
+                      st->wsnap};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
 }
