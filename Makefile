@@ -441,7 +441,7 @@ examples-build: $(EXAMPLE_BINS)
 
 # Only pkg-config output (plus an rpath to the stage) - no -Iinclude here.
 # -lm is the examples' own need (they call floor, ceil, ...), not libodhs's.
-build/examples/%: examples/%.c examples/cli.h $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
+build/examples/%: examples/%.c examples/cli.h examples/plot.h $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
 	@mkdir -p $(@D)
 	$(CC) $(CONSUMER_CFLAGS) -o $@ $< \
 	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) -lm $(STAGE_RPATH)
@@ -602,10 +602,13 @@ fuzz-ci: fuzz
 .PHONY: deps deps-if-missing
 # clang and libclang-rt-14-dev (libFuzzer, sanitizer runtimes): make fuzz.
 # openmpi-bin and libopenmpi-dev (mpicc, mpirun): sweep_mpi and make check-mpi.
+# lammps (lmp), python3-ase, python3-numpy: tests/examples_cli.sh reads the
+# examples' files with LAMMPS, ASE and numpy (skipped with a message without them).
 DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
                  check pkg-config gcc make \
                  clang libclang-rt-14-dev \
-                 openmpi-bin libopenmpi-dev
+                 openmpi-bin libopenmpi-dev \
+                 lammps python3-ase python3-numpy
 
 deps:
 	@if [ "$$(id -u)" -eq 0 ]; then SUDO=; else SUDO=sudo; fi; \

@@ -34,7 +34,7 @@
 
 #include "bench.h"
 #include "odhs.h"
-#include "plot.h"
+#include "../examples/plot.h"
 
 #define NSNAP 4000
 #define NFINE 4000

@@ -17,7 +17,7 @@
 #include "odhs.h"
 
 #include "bench.h"
-#include "plot.h"
+#include "../examples/plot.h"
 
 #define CHECK(call)                                                                                          \
     do {                                                                                                     \

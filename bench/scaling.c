@@ -45,7 +45,7 @@
 
 #include "bench.h"
 #include "odhs.h"
-#include "plot.h"
+#include "../examples/plot.h"
 
 enum { S_DEFAULT, S_PAPER, S_COUNT };
 static const char *const sname[S_COUNT] = {"default (library defaults, auto)", "paper (euler 1e-5, cg)"};

@@ -69,7 +69,7 @@
 
 #include "bench.h"
 #include "odhs.h"
-#include "plot.h"
+#include "../examples/plot.h"
 
 #ifdef ODHS_HAVE_SUITESPARSE
 #if defined(__GNUC__)

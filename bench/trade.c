@@ -33,7 +33,7 @@
 
 #include "bench.h"
 #include "odhs.h"
-#include "plot.h"
+#include "../examples/plot.h"
 
 #define NSAMP 20
 

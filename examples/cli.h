@@ -22,12 +22,20 @@
  * value prints a message and the usage to stderr and exits 2; options are
  * read in order, the last one wins; a value is the next argument, whatever
  * it looks like. The usage shows each option's default as the variable holds
- * it before the command line is read. */
+ * it before the command line is read.
+ *
+ * The defaults are the library's: the adaptive Heun scheme and the "auto"
+ * solver. The paper's scheme ("paper mode") is --integrator euler --solver cg.
+ * An example that includes this header defines _POSIX_C_SOURCE first (for
+ * isatty and fileno, used by the progress line). */
 #ifndef ODHS_EXAMPLES_CLI_H
 #define ODHS_EXAMPLES_CLI_H
 
 #include <errno.h>
 #include <limits.h>
+#include <stdarg.h>
+#include <time.h>
+#include <unistd.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -125,16 +133,21 @@ typedef struct {
 
 /* the integrators of the stepper, by index (--integrator) */
 static const char *const cli_integrators[] = {"euler", "heun", NULL};
+#define CLI_DEFAULT_INTEGRATOR ODHS_INTEGRATOR_HEUN /* the library's default */
+#define CLI_DEFAULT_SOLVER "auto"                   /* the library's automatic choice */
 _Static_assert(ODHS_INTEGRATOR_EULER == 0 && ODHS_INTEGRATOR_HEUN == 1, "cli_integrators is indexed by the enum");
 
-#define CLI_SOLVER_HELP "linear solver: cg, dense, cholmod, cholmod-pcg, spqr"
-/* what cli_default_solver picks */
-#define CLI_SOLVER_AUTO "cholmod-pcg when built with SuiteSparse, else dense up to N = 2000 and cg above"
+#define CLI_SOLVER_HELP                                                                                              \
+    "linear solver: auto (a direct or preconditioned solver chosen by size, with fallbacks), cg, dense, cholmod, "   \
+    "cholmod-pcg, spqr; paper mode: cg"
 
 #define CLI_IN(p)                                                                                                    \
-    CLI_OPT_STRING("--in", p, "FILE.xyz", "start from a configuration file (extended XYZ) instead of the built-in " \
-                   "scene", CLI_ANY)
-#define CLI_OUT(p) CLI_OPT_STRING("--out", p, "FILE.xyz", "write the final configuration (extended XYZ)", CLI_ANY)
+    CLI_OPT_STRING("--in", p, "FILE.xyz", "start from a configuration file (extended XYZ, or a LAMMPS data file: " \
+                   ".data, .lmp) instead of the built-in scene", CLI_ANY)
+#define CLI_OUT(p)                                                                                                   \
+    CLI_OPT_STRING("--out", p, "FILE.xyz",                                                                           \
+                   "write the final configuration (extended XYZ; a LAMMPS data file when named .data or .lmp)",     \
+                   CLI_ANY)
 #define CLI_SVG(p)                                                                                                   \
     CLI_OPT_STRING("--svg", p, "FILE.svg",                                                                           \
                    "picture of the final state: discs coloured by size, contact forces as lines of width "           \
@@ -142,10 +155,10 @@ _Static_assert(ODHS_INTEGRATOR_EULER == 0 && ODHS_INTEGRATOR_HEUN == 1, "cli_int
                    CLI_ANY)
 /* columns: the CSV header line, also given to cli_series */
 #define CLI_SERIES(p, columns) CLI_OPT_STRING("--series", p, "FILE.csv", "write " columns " per output interval", CLI_ANY)
-#define CLI_SOLVER(p) CLI_OPT_STRING("--solver", p, "NAME", CLI_SOLVER_HELP, .deftext = CLI_SOLVER_AUTO)
+#define CLI_SOLVER(p) CLI_OPT_STRING("--solver", p, "NAME", CLI_SOLVER_HELP, CLI_ANY)
 #define CLI_INTEGRATOR(p)                                                                                            \
-    CLI_OPT_LIST("--integrator", p, "NAME", "euler (the paper's fixed step --dt) or heun (adaptive, steps of at most " \
-                 "--dt)", cli_integrators, CLI_ANY)
+    CLI_OPT_LIST("--integrator", p, "NAME", "heun (adaptive, steps of at most --dt) or euler (the paper's fixed step " \
+                 "--dt; paper mode: --integrator euler --solver cg)", cli_integrators, CLI_ANY)
 #define CLI_TOL(p) CLI_OPT_DOUBLE("--tol", p, "X", "heun: error per step relative to the mean diameter", CLI_OPEN(0, 1))
 /* unit: what --dt and --every are measured in */
 #define CLI_DT(p, unit) CLI_OPT_DOUBLE("--dt", p, "X", "step in " unit, CLI_POSITIVE)
@@ -159,6 +172,22 @@ _Static_assert(ODHS_INTEGRATOR_EULER == 0 && ODHS_INTEGRATOR_HEUN == 1, "cli_int
 #define CLI_DIM(p) CLI_OPT_INT("--dim", p, "D", "built-in scene: dimension 2 or 3", CLI_BETWEEN(2, 3))
 #define CLI_SCENE(n, dim, seed) CLI_N(n), CLI_DIM(dim), CLI_SEED(seed)
 #define CLI_PHI(p) CLI_OPT_DOUBLE("--phi", p, "X", "built-in scene: packing fraction", CLI_OPEN(0, 1))
+#define CLI_QUIET(p) CLI_OPT_FLAG("--quiet", p, "no progress messages on stderr (errors still)")
+/* trajectories (cli_traj below); unit: what --traj-every is measured in */
+#define CLI_TRAJ(p)                                                                                                  \
+    CLI_OPT_STRING("--traj", p, "FILE",                                                                              \
+                   "write a trajectory: extended XYZ (.xyz, for OVITO and ASE) or a LAMMPS custom dump (.dump, "     \
+                   ".lammpstrj), one frame at the start and at each output at least --traj-every after the last",  \
+                   CLI_ANY)
+#define CLI_TRAJ_EVERY(p, unit)                                                                                      \
+    CLI_OPT_DOUBLE("--traj-every", p, "X", "interval between trajectory frames in " unit, CLI_POSITIVE,             \
+                   .deftext = "every output")
+#define CLI_TRAJ_CONTACTS(p)                                                                                         \
+    CLI_OPT_STRING("--traj-contacts", p, "FILE",                                                                     \
+                   "write the contact network of each trajectory frame as a LAMMPS dump local (OVITO bonds)",       \
+                   CLI_ANY)
+#define CLI_CONTACTS(p)                                                                                              \
+    CLI_OPT_STRING("--contacts", p, "FILE.csv", "write the final contacts as CSV: i,j,kind,force,gap", CLI_ANY)
 
 /* ---- parser and usage -------------------------------------------------------- */
 
@@ -364,19 +393,6 @@ static inline int cli_scene(int dim, unsigned long n, unsigned long seed, double
     return odhs_system_place_random(*out, phi0, seed + 1);
 }
 
-/* The solver the examples use close to jamming (CLI_SOLVER_AUTO): CHOLMOD as
- * a preconditioner for CG when the library has it, else dense Cholesky for
- * small systems and CG for large ones (CG alone stalls close to jamming). */
-static inline const char *cli_default_solver(size_t n)
-{
-    odhs_solver *s;
-    if (odhs_solver_create_by_name("cholmod-pcg", &s) == ODHS_OK) {
-        odhs_solver_destroy(s);
-        return "cholmod-pcg";
-    }
-    return n <= 2000 ? "dense" : "cg";
-}
-
 /* the solver of that name; 0, or 2 (a bad --solver) with a message */
 static inline int cli_solver(const char *prog, const char *name, odhs_solver **out)
 {
@@ -386,12 +402,48 @@ static inline int cli_solver(const char *prog, const char *name, odhs_solver **o
     return 2;
 }
 
-/* the configuration in the file (--in); 0, or 1 (unreadable) with a message */
+/* whether path names a LAMMPS data file: it ends in .data, .lmp or .lammps,
+ * or (another name) its first line is not a particle count */
+static inline int cli_is_lammps_data_(const char *path)
+{
+    static const char *const ends[] = {".data", ".lmp", ".lammps"};
+    size_t n = strlen(path);
+    for (size_t k = 0; k < sizeof ends / sizeof ends[0]; ++k) {
+        size_t m = strlen(ends[k]);
+        if (n > m && !strcmp(path + n - m, ends[k])) return 1;
+    }
+    if (n > 4 && (!strcmp(path + n - 4, ".xyz") || (n > 7 && !strcmp(path + n - 7, ".extxyz")))) return 0;
+    FILE *f = fopen(path, "r");
+    char line[64] = "";
+    if (!f) return 0; /* the reader reports it */
+    int got = fgets(line, sizeof line, f) != NULL;
+    fclose(f);
+    unsigned long v;
+    line[strcspn(line, "\r\n")] = 0;
+    return got && cli_ulong(line + strspn(line, " \t"), &v) != 0;
+}
+
+/* the configuration in the file (--in): extended XYZ, or a LAMMPS data file
+ * (atom_style sphere); 0, or 1 (unreadable) with a message */
 static inline int cli_read_xyz(const char *prog, const char *path, odhs_system **out)
 {
     char err[512];
-    if (!odhs_xyz_read(path, out, err, sizeof err)) return 0;
+    int lammps = cli_is_lammps_data_(path);
+    if (!(lammps ? odhs_lammps_data_read(path, out, err, sizeof err) : odhs_xyz_read(path, out, err, sizeof err)))
+        return 0;
     fprintf(stderr, "%s: cannot read %s: %s\n", prog, path, err);
+    return 1;
+}
+
+/* --out: extended XYZ, or a LAMMPS data file for the names of
+ * cli_is_lammps_data_'s list; 0, or 1 with a message */
+static inline int cli_write_config(const char *prog, const odhs_system *sys, const char *path)
+{
+    size_t n = strlen(path);
+    int lammps = (n > 5 && !strcmp(path + n - 5, ".data")) || (n > 4 && !strcmp(path + n - 4, ".lmp")) ||
+                 (n > 7 && !strcmp(path + n - 7, ".lammps"));
+    if (!(lammps ? odhs_lammps_data_write(sys, path) : odhs_xyz_write(sys, path))) return 0;
+    fprintf(stderr, "%s: cannot write %s: %s\n", prog, path, odhs_system_errmsg(sys));
     return 1;
 }
 
@@ -407,9 +459,12 @@ static inline int cli_start(const char *prog, const char *in, int dim, unsigned 
     return 1;
 }
 
-/* the --series file opened with its header line, or *out = NULL without a
- * path; 0, or 1 (cannot write) with a message */
-static inline int cli_series(const char *prog, const char *path, const char *columns, FILE **out)
+/* the --series file opened with its header line (then units, when not NULL,
+ * as a comment line "# units: ..."; numpy.genfromtxt(names=True) skips it,
+ * pandas.read_csv wants comment="#"), or *out = NULL without a path; 0, or
+ * 1 (cannot write) with a message */
+static inline int cli_series_units(const char *prog, const char *path, const char *columns, const char *units,
+                                   FILE **out)
 {
     *out = NULL;
     if (!path) return 0;
@@ -418,7 +473,145 @@ static inline int cli_series(const char *prog, const char *path, const char *col
         return 1;
     }
     fprintf(*out, "%s\n", columns);
+    if (units) fprintf(*out, "# units: %s\n", units);
     return 0;
+}
+
+static inline int cli_series(const char *prog, const char *path, const char *columns, FILE **out)
+{
+    return cli_series_units(prog, path, columns, NULL, out);
+}
+
+/* ---- progress on stderr ------------------------------------------------------- */
+
+/* One updating line (carriage return) with the elapsed time, the rate (of
+ * the run's own unit: strain, time, ...) and the estimated time left when
+ * stderr is a terminal; otherwise plain lines, at most one every
+ * CLI_PROGRESS_LOG seconds and one at the end; nothing with --quiet. */
+#define CLI_PROGRESS_LOG 10.0
+
+typedef struct {
+    const char *prog;
+    int quiet, tty, shown; /* shown: a line is on the terminal, not ended */
+    double t0, last;       /* wall-clock seconds at the start, at the last line */
+    char text[256];
+} cli_progress;
+
+static inline double cli_now_(void)
+{
+    struct timespec ts;
+    timespec_get(&ts, TIME_UTC);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static inline void cli_progress_init(cli_progress *p, const char *prog, int quiet)
+{
+    memset(p, 0, sizeof *p);
+    p->prog = prog;
+    p->quiet = quiet;
+    p->tty = isatty(fileno(stderr));
+    p->t0 = p->last = cli_now_();
+}
+
+/* done of total (in the run's own unit) and a description; final: the last
+ * call (always printed) */
+static inline void cli_progress_show(cli_progress *p, double done, double total, int final, const char *fmt, ...)
+{
+    if (p->quiet) return;
+    double now = cli_now_(), el = now - p->t0;
+    if (!p->tty && !final && now - p->last < CLI_PROGRESS_LOG) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(p->text, sizeof p->text, fmt, ap);
+    va_end(ap);
+    char eta[64] = "";
+    if (!final && done > 0.0 && total > done && el > 0.0)
+        snprintf(eta, sizeof eta, ", %.3g/s, %.0f s left", done / el, el * (total - done) / done);
+    fprintf(stderr, "%s%s: %s, %.1f s%s%s", p->tty ? "\r" : "", p->prog, p->text, el, eta,
+            p->tty && !final ? "\033[K" : "\n");
+    if (p->tty && final) p->shown = 0;
+    else p->shown = p->tty;
+    p->last = now;
+}
+
+/* end an updating line before other output on stderr */
+static inline void cli_progress_break(cli_progress *p)
+{
+    if (p->shown) fputc('\n', stderr);
+    p->shown = 0;
+}
+
+/* ---- trajectories (--traj, --traj-every, --traj-contacts) ---------------------------- */
+
+/* Frames are written at the example's outputs (never at extra stopping
+ * points, so a trajectory never changes the run): at the start and at each
+ * output at least `every` after the last frame (every <= 0: each output). */
+typedef struct {
+    const char *prog, *path, *cpath;
+    odhs_traj *tr, *contacts;
+    double every, last;
+    int started;
+} cli_traj;
+
+/* open the files named (either may be NULL); 0, or 2 (a --traj name of no
+ * known format) or 1 (cannot write) with a message */
+static inline int cli_traj_open(cli_traj *t, const char *prog, const char *path, const char *contacts, double every)
+{
+    memset(t, 0, sizeof *t);
+    t->prog = prog;
+    t->path = path;
+    t->cpath = contacts;
+    t->every = every;
+    char err[512];
+    int format = ODHS_TRAJ_XYZ;
+    if (path && odhs_traj_format_for(path, &format)) {
+        fprintf(stderr, "%s: --traj %s: name the file .xyz or .extxyz (extended XYZ) or .dump or .lammpstrj (LAMMPS "
+                        "dump)\n", prog, path);
+        return 2;
+    }
+    if ((path && odhs_traj_open(path, format, &t->tr, err, sizeof err)) ||
+        (contacts && odhs_traj_open(contacts, ODHS_TRAJ_LAMMPS_LOCAL, &t->contacts, err, sizeof err))) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        odhs_traj_close(t->tr);
+        t->tr = NULL;
+        return 1;
+    }
+    return 0;
+}
+
+/* at an output where the run's clock (strain, time, ...) reads x: a frame if
+ * one is due; 0, or 1 with a message */
+static inline int cli_traj_output(cli_traj *t, const odhs_system *sys, const odhs_stepper *st, double x)
+{
+    if (!t->tr && !t->contacts) return 0;
+    if (t->started && !(x - t->last >= t->every * (1.0 - 1e-9))) return 0;
+    t->started = 1;
+    t->last = x;
+    if (t->tr && odhs_traj_write(t->tr, sys, st)) {
+        fprintf(stderr, "%s: %s: %s\n", t->prog, t->path, odhs_traj_errmsg(t->tr));
+        return 1;
+    }
+    if (t->contacts && st && odhs_traj_write(t->contacts, sys, st)) {
+        fprintf(stderr, "%s: %s: %s\n", t->prog, t->cpath, odhs_traj_errmsg(t->contacts));
+        return 1;
+    }
+    return 0;
+}
+
+/* close the files; 0, or 1 with a message */
+static inline int cli_traj_close(cli_traj *t)
+{
+    int bad = 0;
+    if (odhs_traj_close(t->tr)) {
+        fprintf(stderr, "%s: error writing %s\n", t->prog, t->path);
+        bad = 1;
+    }
+    if (odhs_traj_close(t->contacts)) {
+        fprintf(stderr, "%s: error writing %s\n", t->prog, t->cpath);
+        bad = 1;
+    }
+    t->tr = t->contacts = NULL;
+    return bad;
 }
 
 #endif /* ODHS_EXAMPLES_CLI_H */

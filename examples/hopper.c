@@ -13,6 +13,7 @@
  * Build against an installed libodhs:
  *     cc hopper.c $(pkg-config --cflags --libs odhs) -lm -o hopper
  */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,6 +25,10 @@
 
 /* the --series columns */
 #define SERIES "time,discharged,mean_speed,z,events"
+/* the default --tol, looser than the library's 1e-6 on purpose (as this
+ * example always ran): the default run is 400 tau of 300 discs in sliding
+ * contact, about 4 times faster at 1e-3, with the same discharge and clogging */
+#define TOL 1e-3
 
 #define CHECK(call)                                                                             \
     do {                                                                                        \
@@ -110,9 +115,11 @@ out:
 
 int main(int argc, char **argv)
 {
-    const char *series = NULL, *svg = NULL, *outpath = NULL, *solver_name = NULL;
-    double outlet = 3.2, width = 24.0, tmax = 400.0, every = 1.0;
+    const char *series = NULL, *svg = NULL, *outpath = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *traj = NULL, *traj_contacts = NULL;
+    double outlet = 3.2, width = 24.0, tmax = 400.0, every = 1.0, tol = TOL, traj_every = 0.0;
     unsigned long n = 300, seed = 1;
+    int integrator = CLI_DEFAULT_INTEGRATOR, quiet = 0;
     const cli_opt opts[] = {
         CLI_OPT_ULONG("--n", &n, "N", "number of discs, radii 0.5 and 0.7 +-5%", CLI_ATLEAST(1)),
         CLI_OPT_DOUBLE("--outlet", &outlet, "D", "outlet width in small diameters", CLI_ABOVE(1)),
@@ -120,10 +127,16 @@ int main(int argc, char **argv)
         CLI_TIME(&tmax),
         CLI_EVERY(&every, "tau"),
         CLI_SEED(&seed),
+        CLI_INTEGRATOR(&integrator),
+        CLI_TOL(&tol),
         CLI_SOLVER(&solver_name),
         CLI_SERIES(&series, SERIES),
         CLI_SVG(&svg),
         CLI_OUT(&outpath),
+        CLI_TRAJ(&traj),
+        CLI_TRAJ_EVERY(&traj_every, "tau"),
+        CLI_TRAJ_CONTACTS(&traj_contacts),
+        CLI_QUIET(&quiet),
         CLI_END,
     };
     const cli_spec cli = {"hopper", NULL, opts,
@@ -131,6 +144,9 @@ int main(int argc, char **argv)
                           "grey and the arch dark red.\n"
                           "Time in units of tau = lambda/(xi0 f_rms) (lambda the mean diameter, f_rms the\n"
                           "rms weight); the weight of a disc is proportional to its area.\n"
+                          "Defaults are the library's (adaptive Heun, the auto solver) but for --tol\n"
+                          "(1e-3, not 1e-6: a faster run); paper mode: --integrator euler --solver cg.\n"
+                          "The step (--dt elsewhere) is 0.05 tau, at most with heun.\n"
                           "Exit status 0 whether or not the outlet clogged (stdout says which).\n",
                           0};
     int rc = cli_parse(&cli, argc, argv);
@@ -181,7 +197,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "hopper: %s\n", odhs_system_errmsg(sys));
         return 1;
     }
-    if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
     if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
     odhs_driver *drv;
@@ -193,13 +208,14 @@ int main(int argc, char **argv)
     double a1[2] = {0.5 * (width + outlet), yout}, b1[2] = {width, ytop};
     CHECK(odhs_stepper_add_wall_segment(st, a0, b0, NULL)); /* wall 0: left  */
     CHECK(odhs_stepper_add_wall_segment(st, a1, b1, NULL)); /* wall 1: right */
-    CHECK(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_HEUN));
-    CHECK(odhs_stepper_set_tolerance(st, 1e-3));
+    CHECK(odhs_stepper_set_integrator(st, integrator));
+    CHECK(odhs_stepper_set_tolerance(st, tol));
     CHECK(odhs_stepper_set_dt(st, 0.05));
     double tau;
     CHECK(odhs_driver_time_unit(drv, sys, &tau));
-    fprintf(stderr, "hopper: N = %lu, outlet %.2f, box %.1f x %.1f, solver %s, tau = %.4g\n", n, outlet, L[0], L[1],
-            odhs_solver_name(solver), tau);
+    if (!quiet)
+        fprintf(stderr, "hopper: N = %lu, outlet %.2f, box %.1f x %.1f, %s, solver %s, tau = %.4g\n", n, outlet,
+                L[0], L[1], cli_integrators[integrator], odhs_solver_name(solver), tau);
 
     FILE *csv;
     if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
@@ -208,12 +224,21 @@ int main(int argc, char **argv)
     odhs_system_get_positions(sys, xp);
     unsigned long discharged = 0;
     double t = 0.0, t_last = -1.0, t_clog = -1.0, vfree = 2.0; /* speed of a free large disc */
+    cli_progress prog;
+    cli_traj tr;
+    cli_progress_init(&prog, cli.prog, quiet);
+    if (cli_traj_open(&tr, cli.prog, traj, traj_contacts, traj_every)) return 1;
+    /* the first frame, at the start: the state the first step would make
+     * (a failure here recurs at the first step, which reports it) */
+    odhs_stepper_reset(st);
+    if (cli_traj_output(&tr, sys, st, 0.0)) return 1;
     printf("%10s %11s %12s %8s %10s\n", "time/tau", "discharged", "mean_speed", "z", "events");
     long nout = (long)ceil(tmax / every - 1e-9);
     for (long q = 1; q <= nout; ++q) {
         rc = odhs_stepper_run_until_time(st, fmin(q * every, tmax) * tau);
         if (rc) {
-            fprintf(stderr, "\nhopper: stopped: %s (%s)\n", odhs_strerror(rc), odhs_stepper_errmsg(st));
+            cli_progress_break(&prog);
+            fprintf(stderr, "hopper: stopped: %s (%s)\n", odhs_strerror(rc), odhs_stepper_errmsg(st));
             break;
         }
         odhs_stepper_time(st, &t);
@@ -235,14 +260,17 @@ int main(int argc, char **argv)
         odhs_stepper_counts(st, NULL, &nc, &no);
         odhs_stepper_coordination(st, &z);
         printf("%10.2f %11lu %12.4e %8.4f %10llu\n", t / tau, discharged, vmean, z, (unsigned long long)(nc + no));
-        if (csv) fprintf(csv, "%.6g,%lu,%.6e,%.6f,%llu\n", t / tau, discharged, vmean, z, (unsigned long long)(nc + no));
-        fprintf(stderr, "\rhopper: t = %.1f tau, %lu discharged, mean speed %.3g   ", t / tau, discharged, vmean);
-        if (vmax < 1e-9 * vfree) { /* everything at rest: the outlet is clogged */
+        if (csv)
+            fprintf(csv, "%.6g,%lu,%.6e,%.6f,%llu\n", t / tau, discharged, vmean, z, (unsigned long long)(nc + no));
+        if (cli_traj_output(&tr, sys, st, t / tau)) return 1;
+        int clogged = vmax < 1e-9 * vfree; /* everything at rest: the outlet is clogged */
+        cli_progress_show(&prog, t / tau, tmax, q == nout || clogged, "t = %.1f tau, %lu discharged, mean speed %.3g",
+                          t / tau, discharged, vmean);
+        if (clogged) {
             t_clog = t / tau;
             break;
         }
     }
-    fprintf(stderr, "\n");
     unsigned char *mark = calloc(n, 1);
     size_t arch = 0;
     if (t_clog >= 0.0 && mark) arch = find_arch(odhs_stepper_network(st), n, x, yout, mark);
@@ -261,10 +289,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "hopper: cannot write %s: %s\n", svg, odhs_system_errmsg(sys));
         return 1;
     }
-    if (outpath && odhs_xyz_write(sys, outpath)) {
-        fprintf(stderr, "hopper: cannot write %s: %s\n", outpath, odhs_system_errmsg(sys));
-        return 1;
-    }
+    if (cli_traj_close(&tr)) return 1;
+    if (outpath && cli_write_config(cli.prog, sys, outpath)) return 1;
     free(mark);
     free(xp);
     free(V);

@@ -6,6 +6,7 @@
  *
  *     cc jam_packing.c $(pkg-config --cflags --libs odhs) -lm -o jam_packing
  */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +27,25 @@ static int configure(odhs_stepper *st, int integrator, double dt, double tol, un
     if (!rc && integrator == ODHS_INTEGRATOR_HEUN) rc = odhs_stepper_set_tolerance(st, tol);
     if (!rc) rc = odhs_stepper_set_correction_interval(st, (unsigned)corr);
     return rc;
+}
+
+/* --traj: a frame at the first event after each --traj-every of packing
+ * fraction (compress) or strain (the shear protocols), from the event
+ * callback, so that frames never add stopping points to the run */
+typedef struct {
+    cli_traj traj;
+    const odhs_system *sys;
+    const odhs_stepper *st;
+    int shear, failed;
+} frames;
+
+static int on_event(const odhs_event *ev, void *ctx)
+{
+    frames *fr = ctx;
+    double phi = 0.0;
+    if (!fr->shear) odhs_system_packing_fraction(fr->sys, &phi);
+    if (!fr->failed && cli_traj_output(&fr->traj, fr->sys, fr->st, fr->shear ? ev->strain : phi)) fr->failed = 1;
+    return fr->failed; /* stop the run after a write error */
 }
 
 /* drive with the given driver until jammed (or failure / strain budget) */
@@ -50,17 +70,24 @@ static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, do
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = NULL;
-    double dt = 1e-3, max_strain = 20.0, tol = 1e-6, p_jam = 0.0;
-    int protocol = COMPRESS, integrator = ODHS_INTEGRATOR_HEUN, dim = 2;
+    const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *traj = NULL, *traj_contacts = NULL;
+    double dt = 1e-3, max_strain = 20.0, tol = 1e-6, p_jam = 0.0, traj_every = 0.01;
+    int protocol = COMPRESS, integrator = CLI_DEFAULT_INTEGRATOR, dim = 2, quiet = 0;
     unsigned long corr = 1;
     unsigned long n = 256, seed = 1;
     const cli_opt opts[] = {
         CLI_OPT_LIST("--protocol", &protocol, "P", "compress | shear | shear+compress | pressure", protocols, CLI_ANY),
         CLI_IN(&in),
         CLI_OUT(&outpath),
-        CLI_OPT_STRING("--contacts", &contacts, "FILE", "write its contacts (i j image force gap)", CLI_ANY),
+        CLI_CONTACTS(&contacts),
         CLI_SVG(&svg),
+        CLI_OPT_STRING("--traj", &traj, "FILE",
+                       "write a trajectory: extended XYZ (.xyz, for OVITO and ASE) or a LAMMPS custom dump (.dump, "
+                       ".lammpstrj): the start, a frame at the first event after each --traj-every, the packing",
+                       CLI_ANY),
+        CLI_TRAJ_EVERY(&traj_every, "packing fraction (compress) or strain (the shear protocols)"),
+        CLI_TRAJ_CONTACTS(&traj_contacts),
         CLI_SCENE(&n, &dim, &seed),
         CLI_SOLVER(&solver_name),
         CLI_INTEGRATOR(&integrator),
@@ -75,6 +102,7 @@ int main(int argc, char **argv)
                       "drift correction every K steps; certified packings need contact gaps at round-off when they "
                       "jam",
                       CLI_ATMOST(1000000)),
+        CLI_QUIET(&quiet),
         CLI_END,
     };
     const cli_spec cli = {
@@ -86,6 +114,8 @@ int main(int argc, char **argv)
         "pressure, doubled every 0.05 strain (towards zero strain rate); at a finite\n"
         "pressure the flow would go on, so the run stops at the first network with\n"
         "positive self-stress once p >= --jam-pressure (default 0: at once).\n"
+        "Defaults are the library's (adaptive Heun, the auto solver); paper mode:\n"
+        "--integrator euler --solver cg.\n"
         "Exit status: 0 jammed and certified, 1 error, 2 bad arguments, 3 not jammed\n"
         "or not certified (force balance < 1e-12, gaps < 1e-13, no overlap, all\n"
         "backbone forces > 0, isostatic).\n",
@@ -96,7 +126,6 @@ int main(int argc, char **argv)
     odhs_system *sys = NULL;
     if (cli_start(cli.prog, in, dim, n, seed, 1.0, &sys)) return 1;
     n = odhs_system_count(sys);
-    if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
     if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
     odhs_driver *drv;
@@ -106,8 +135,17 @@ int main(int argc, char **argv)
         fprintf(stderr, "jam_packing: setup failed\n");
         return 1;
     }
-    fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s, %s\n", n, odhs_system_dim(sys),
-            protocols[protocol], solver_name, integrator == ODHS_INTEGRATOR_HEUN ? "heun" : "euler");
+    if (!quiet)
+        fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s, %s\n", n, odhs_system_dim(sys),
+                protocols[protocol], solver_name, cli_integrators[integrator]);
+    frames fr = {.sys = sys, .st = st, .shear = protocol == SHEAR || protocol == PRESSURE};
+    if ((rc = cli_traj_open(&fr.traj, cli.prog, traj, traj_contacts, traj_every))) return rc;
+    if (traj || traj_contacts) {
+        double phi0;
+        odhs_system_packing_fraction(sys, &phi0);
+        if (odhs_stepper_reset(st) || cli_traj_output(&fr.traj, sys, st, fr.shear ? 0.0 : phi0)) return 1;
+        odhs_stepper_set_event_callback(st, on_event, &fr);
+    }
 
     if (protocol == COMPRESS) {
         odhs_driver_set_compression_rate(drv, 1.0);
@@ -125,8 +163,11 @@ int main(int argc, char **argv)
             odhs_driver_set_shear_rate(drv, 1.0);
             if (odhs_stepper_create(sys, drv, solver, &st) || configure(st, integrator, dt, tol, corr))
                 return 1;
-            fprintf(stderr, "jam_packing: compression jammed at phi = %.6f; shearing at phi = %.6f\n", phi,
-                    phi / 1.002);
+            fr.st = st;
+            if (traj || traj_contacts) odhs_stepper_set_event_callback(st, on_event, &fr);
+            if (!quiet)
+                fprintf(stderr, "jam_packing: compression jammed at phi = %.6f; shearing at phi = %.6f\n", phi,
+                        phi / 1.002);
             rc = drive(st, drv, 1, 0, max_strain);
         }
     } else if (protocol == SHEAR_COMPRESS) {
@@ -140,8 +181,10 @@ int main(int argc, char **argv)
         rc = drive(st, drv, 1, 1, max_strain);
     }
     int status = 0;
-    if (rc == ODHS_JAMMED) {
-        fprintf(stderr, "jam_packing: jammed\n");
+    if (fr.failed) {
+        status = 1;
+    } else if (rc == ODHS_JAMMED) {
+        if (!quiet) fprintf(stderr, "jam_packing: jammed\n");
     } else if (rc == ODHS_OK) {
         fprintf(stderr, "jam_packing: did not jam within the strain budget\n");
         status = 3;
@@ -179,11 +222,11 @@ int main(int argc, char **argv)
         }
     }
     const odhs_network *net = odhs_stepper_network(st);
-    if (outpath && odhs_xyz_write(sys, outpath)) {
-        fprintf(stderr, "jam_packing: cannot write %s: %s\n", outpath, odhs_system_errmsg(sys));
-        status = 1;
-    }
-    if (contacts && odhs_contacts_write(net, sys, contacts)) {
+    /* the packing as the last frame */
+    fr.traj.every = 0.0;
+    if (cli_traj_output(&fr.traj, sys, st, INFINITY) || cli_traj_close(&fr.traj)) status = 1;
+    if (outpath && cli_write_config(cli.prog, sys, outpath)) status = 1;
+    if (contacts && odhs_contacts_write_csv(net, sys, contacts)) {
         fprintf(stderr, "jam_packing: cannot write %s: %s\n", contacts, odhs_network_errmsg(net));
         status = 1;
     }

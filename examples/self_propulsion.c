@@ -14,6 +14,7 @@
  * Build against an installed libodhs:
  *     cc self_propulsion.c $(pkg-config --cflags --libs odhs) -lm -o self_propulsion
  */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -116,10 +117,11 @@ static int add_arrows(const char *path, const odhs_system *sys, const double *F,
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = NULL;
-    double T = 20.0, tmax = 10.0, every = 1.0, dt = 1e-2, phi = 0.5;
+    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *traj = NULL, *traj_contacts = NULL;
+    double T = 20.0, tmax = 10.0, every = 1.0, dt = 1e-2, phi = 0.5, tol = 1e-6, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
-    int dim = 2;
+    int dim = 2, integrator = CLI_DEFAULT_INTEGRATOR, quiet = 0;
     const cli_opt opts[] = {
         CLI_IN(&in),
         CLI_TIME(&T),
@@ -128,10 +130,16 @@ int main(int argc, char **argv)
         CLI_SERIES(&series, SERIES),
         CLI_SVG(&svg),
         CLI_OUT(&outpath),
+        CLI_TRAJ(&traj),
+        CLI_TRAJ_EVERY(&traj_every, "tau"),
+        CLI_TRAJ_CONTACTS(&traj_contacts),
         CLI_DT(&dt, "units of tau"),
+        CLI_INTEGRATOR(&integrator),
+        CLI_TOL(&tol),
         CLI_SOLVER(&solver_name),
         CLI_PHI(&phi),
         CLI_SCENE(&n, &dim, &seed),
+        CLI_QUIET(&quiet),
         CLI_END,
     };
     const cli_spec cli = {
@@ -140,7 +148,9 @@ int main(int argc, char **argv)
         "propulsion force. The picture (--svg) is like Fig. 8 of the paper, with the\n"
         "propulsion forces as green arrows (2D).\n"
         "Lengths are in units of the mean diameter lambda, times in\n"
-        "tau = lambda/(f_ext xi0), speeds in lambda/tau, pressure in f_ext/lambda^(d-1).\n",
+        "tau = lambda/(f_ext xi0), speeds in lambda/tau, pressure in f_ext/lambda^(d-1).\n"
+        "Defaults are the library's (adaptive Heun, the auto solver); paper mode:\n"
+        "--integrator euler --solver cg.\n",
         0};
     int rc = cli_parse(&cli, argc, argv);
     if (rc != CLI_GO) return rc;
@@ -154,13 +164,13 @@ int main(int argc, char **argv)
         if (!rc) rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.0, 0.03, seed);
         if (!rc) rc = odhs_system_place_random(sys, phi, seed + 1);
         if (rc) {
-            fprintf(stderr, "self_propulsion: building the scene: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
+            fprintf(stderr, "self_propulsion: building the scene: %s\n",
+                    sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
             return 1;
         }
     }
     n = odhs_system_count(sys);
     int d = odhs_system_dim(sys);
-    if (!solver_name) solver_name = cli_default_solver(n);
     odhs_solver *solver;
     if ((rc = cli_solver(cli.prog, solver_name, &solver))) return rc;
     double phi_now, *r = malloc(n * sizeof *r), lambda = 0.0;
@@ -176,10 +186,13 @@ int main(int argc, char **argv)
     CHECK(odhs_driver_set_self_propulsion(drv, n, d, 0.0, sqrt(3.0), 0.0, tmax, seed + 2));
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
     CHECK(odhs_stepper_set_dt(st, dt));
+    CHECK(odhs_stepper_set_integrator(st, integrator));
+    CHECK(odhs_stepper_set_tolerance(st, tol));
     double tau;
     CHECK(odhs_driver_time_unit(drv, sys, &tau));
-    fprintf(stderr, "self_propulsion: N = %lu, d = %d, phi = %.4f, persistence in [0, %g] tau, solver %s\n", n, d,
-            phi_now, tmax, odhs_solver_name(solver));
+    if (!quiet)
+        fprintf(stderr, "self_propulsion: N = %lu, d = %d, phi = %.4f, persistence in [0, %g] tau, %s, solver %s\n",
+                n, d, phi_now, tmax, cli_integrators[integrator], odhs_solver_name(solver));
     rc = odhs_stepper_reset(st);
     if (rc < 0) {
         fprintf(stderr, "self_propulsion: %s\n", odhs_stepper_errmsg(st));
@@ -188,6 +201,10 @@ int main(int argc, char **argv)
 
     FILE *csv;
     if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
+    cli_progress prog;
+    cli_traj tr;
+    cli_progress_init(&prog, cli.prog, quiet);
+    if (cli_traj_open(&tr, cli.prog, traj, traj_contacts, traj_every)) return 1;
     printf("%10s %12s %14s %8s %10s %10s\n", "time", "mean_speed", "pressure", "z", "collisions", "openings");
     double *V = malloc(n * d * sizeof *V);
     long nout = (long)ceil(T / every - 1e-9);
@@ -197,7 +214,8 @@ int main(int argc, char **argv)
         if (k > 0) {
             rc = odhs_stepper_run_until_time(st, target);
             if (rc) {
-                fprintf(stderr, "\nself_propulsion: stopped at t = %.6g tau: %s (%s)\n", target / tau,
+                cli_progress_break(&prog);
+                fprintf(stderr, "self_propulsion: stopped at t = %.6g tau: %s (%s)\n", target / tau,
                         odhs_strerror(rc), odhs_stepper_errmsg(st));
                 break;
             }
@@ -221,18 +239,19 @@ int main(int argc, char **argv)
         if (csv)
             fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu,%llu\n", t / tau, speed, p, z, (unsigned long long)nc,
                     (unsigned long long)no);
-        fprintf(stderr, "\rself_propulsion: t = %.2f / %.2f tau, %llu steps, %llu events", t / tau, T,
-                (unsigned long long)steps, (unsigned long long)(nc + no));
+        if (cli_traj_output(&tr, sys, st, t / tau)) return 1;
+        cli_progress_show(&prog, t / tau, T, k == nout, "t = %.2f / %.2f tau, %llu steps, %llu events", t / tau, T,
+                          (unsigned long long)steps, (unsigned long long)(nc + no));
     }
-    fprintf(stderr, "\n");
     free(V);
     /* contacts back to exact touching before the report and the pictures */
     if (rc == 0 && odhs_stepper_correct(st) < 0)
         fprintf(stderr, "self_propulsion: final correction failed: %s\n", odhs_stepper_errmsg(st));
     double gap, ov;
     odhs_stepper_errors(st, &gap, &ov);
-    fprintf(stderr, "self_propulsion: worst contact gap %.3g, worst overlap %.3g (relative to contact distance)\n",
-            gap, ov);
+    if (!quiet)
+        fprintf(stderr, "self_propulsion: worst contact gap %.3g, worst overlap %.3g (relative to contact distance)\n",
+                gap, ov);
     if (csv && fclose(csv)) {
         fprintf(stderr, "self_propulsion: error writing %s\n", series);
         return 1;
@@ -248,10 +267,8 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    if (outpath && odhs_xyz_write(sys, outpath)) {
-        fprintf(stderr, "self_propulsion: cannot write %s: %s\n", outpath, odhs_system_errmsg(sys));
-        return 1;
-    }
+    if (cli_traj_close(&tr)) return 1;
+    if (outpath && cli_write_config(cli.prog, sys, outpath)) return 1;
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(solver);

@@ -25,14 +25,64 @@
 #include <odhs.h>
 
 #include "cli.h"
+#include "plot.h"
 
-/* the --series columns */
-#define SERIES "strain,shear_stress,pressure,z,events"
-/* ... at fixed pressure: the two panels of the paper's Fig. 7 as well */
-#define SERIES_P "strain,shear_stress,pressure,z,events,phi,kappa"
+/* the --series columns (columns are only ever added, at the end) */
+#define SERIES "strain,shear_stress,pressure,z,events,phi,kappa,time,collisions,openings,dissipation"
 /* ... with --oscillate, and the --strobe columns */
-#define SERIES_OSC "time,strain,shear_stress,pressure,z,events"
+#define SERIES_OSC "time,strain,shear_stress,pressure,z,events,phi,kappa,collisions,openings,dissipation"
 #define STROBE "cycle,strobe_rms,from_start,events"
+#define UNITS                                                                                                        \
+    "strain and time 1/gammadot; shear_stress, pressure gammadot/xi0 (2D per length, 3D per area); kappa "          \
+    "compression rate/gammadot; dissipation lambda^2 gammadot^2/xi0 (lambda the small diameter); z, events, "       \
+    "collisions, openings, phi dimensionless"
+
+/* what the outputs share: the series file, the progress line, the
+ * trajectory and the plot's points */
+typedef struct {
+    FILE *csv;
+    cli_progress prog;
+    cli_traj traj;
+    pl_plot panel[4]; /* stresses, z, and under pressure phi and kappa */
+    int npanel;
+    int fixed_p;
+} outputs;
+
+/* one output row: the table on stdout, the series row, a trajectory frame
+ * when due, the plot's points; x is the strain (or the time of an
+ * oscillation); 0, or 1 after an error (reported) */
+static int output(outputs *o, odhs_stepper *st, odhs_system *sys, double x, double g, double t, int osc)
+{
+    double s, p, z, kappa, phi, D = NAN;
+    uint64_t steps, nc, no;
+    odhs_stepper_shear_stress(st, &s);
+    odhs_stepper_pressure(st, &p);
+    odhs_stepper_coordination(st, &z);
+    odhs_stepper_kappa(st, &kappa);
+    odhs_stepper_dissipation(st, &D);
+    odhs_stepper_counts(st, &steps, &nc, &no);
+    odhs_system_packing_fraction(sys, &phi);
+    unsigned long long ev = (unsigned long long)(nc + no);
+    if (osc) printf("%12.6f %12.6f %14.6e %14.6e %8.4f %10llu\n", t, g, s, p, z, ev);
+    else if (o->fixed_p) printf("%12.6f %14.6e %14.6e %8.4f %10llu %10.6f %14.6e\n", g, s, p, z, ev, phi, kappa);
+    else printf("%12.6f %14.6e %14.6e %8.4f %10llu\n", g, s, p, z, ev);
+    if (o->csv && osc)
+        fprintf(o->csv, "%.10g,%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g,%llu,%llu,%.10g\n", t, g, s, p, z, ev, phi, kappa,
+                (unsigned long long)nc, (unsigned long long)no, D);
+    else if (o->csv)
+        fprintf(o->csv, "%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g,%.10g,%llu,%llu,%.10g\n", g, s, p, z, ev, phi, kappa, t,
+                (unsigned long long)nc, (unsigned long long)no, D);
+    if (o->npanel) {
+        pl_point(&o->panel[0], 0, x, s);
+        pl_point(&o->panel[0], 1, x, p);
+        pl_point(&o->panel[1], 0, x, z);
+        if (o->npanel > 2) {
+            pl_point(&o->panel[2], 0, x, phi);
+            pl_point(&o->panel[3], 0, x, kappa);
+        }
+    }
+    return cli_traj_output(&o->traj, sys, st, x);
+}
 
 #define CHECK(call)                                                                             \
     do {                                                                                        \
@@ -45,7 +95,7 @@
 
 /* Build the default scene: RSA at a low packing fraction, then event-driven
  * isotropic compression to phi. */
-static int build_scene(int dim, unsigned long n, double phi, unsigned long seed, odhs_solver *solver,
+static int build_scene(int dim, unsigned long n, double phi, unsigned long seed, odhs_solver *solver, int quiet,
                        odhs_system **out)
 {
     odhs_system *sys = NULL;
@@ -63,7 +113,7 @@ static int build_scene(int dim, unsigned long n, double phi, unsigned long seed,
         CHECK(odhs_driver_set_compression_rate(drv, 1.0));
         CHECK(odhs_stepper_create(sys, drv, solver, &st));
         CHECK(odhs_stepper_set_dt(st, 1e-3));
-        fprintf(stderr, "shear_flow: compressing from phi = %.3f to %.3f\n", phi0, phi);
+        if (!quiet) fprintf(stderr, "shear_flow: compressing from phi = %.3f to %.3f\n", phi0, phi);
         rc = odhs_stepper_run_until_packing_fraction(st, phi);
         if (rc) {
             fprintf(stderr, "shear_flow: compression stopped: %s (%s)\n", odhs_strerror(rc),
@@ -127,7 +177,7 @@ typedef struct {
 
 /* the oscillatory run: outputs per cycle, stroboscopic displacement after
  * each; 0, or 1 after an error (reported) */
-static int run_oscillation(odhs_stepper *st, odhs_system *sys, const oscillation *o, FILE *csv)
+static int run_oscillation(odhs_stepper *st, odhs_system *sys, const oscillation *o, outputs *out)
 {
     size_t nd = odhs_system_count(sys) * (size_t)odhs_system_dim(sys);
     double *x0 = malloc(nd * sizeof *x0), *xp = malloc(nd * sizeof *xp), *x = malloc(nd * sizeof *x);
@@ -144,22 +194,23 @@ static int run_oscillation(odhs_stepper *st, odhs_system *sys, const oscillation
             double t = o->period * ((double)c + (double)k / (double)o->per_cycle);
             int s = odhs_stepper_run_until_time(st, t);
             if (s) {
-                fprintf(stderr, "\nshear_flow: stopped at time %.6g: %s (%s)\n", t, odhs_strerror(s),
+                cli_progress_break(&out->prog);
+                fprintf(stderr, "shear_flow: stopped at time %.6g: %s (%s)\n", t, odhs_strerror(s),
                         odhs_stepper_errmsg(st));
                 rc = 1;
                 break;
             }
-            double g, sxy, p, z;
+            double g;
             uint64_t steps, nc, no;
             odhs_stepper_strain(st, &g);
-            odhs_stepper_shear_stress(st, &sxy);
-            odhs_stepper_pressure(st, &p);
-            odhs_stepper_coordination(st, &z);
             odhs_stepper_counts(st, &steps, &nc, &no);
-            printf("%12.6f %12.6f %14.6e %14.6e %8.4f %10llu\n", t, g, sxy, p, z, (unsigned long long)(nc + no));
-            if (csv) fprintf(csv, "%.10g,%.10g,%.10g,%.10g,%.6f,%llu\n", t, g, sxy, p, z, (unsigned long long)(nc + no));
-            fprintf(stderr, "\rshear_flow: cycle %lu / %lu, %llu steps, %llu events", c + 1, o->cycles,
-                    (unsigned long long)steps, (unsigned long long)(nc + no));
+            if (output(out, st, sys, t, g, t, 1)) {
+                rc = 1;
+                break;
+            }
+            double total = o->period * (double)o->cycles;
+            cli_progress_show(&out->prog, t, total, 0, "cycle %lu / %lu, %llu steps, %llu events", c + 1, o->cycles,
+                              (unsigned long long)steps, (unsigned long long)(nc + no));
         }
         if (rc) break;
         odhs_system_get_positions(sys, x);
@@ -170,7 +221,7 @@ static int run_oscillation(odhs_stepper *st, odhs_system *sys, const oscillation
         if (sf) fprintf(sf, "%lu,%.10g,%.10g,%llu\n", c + 1, d, d0, (unsigned long long)(nc + no));
         memcpy(xp, x, nd * sizeof *xp);
     }
-    fprintf(stderr, "\n");
+    if (!rc) cli_progress_show(&out->prog, 1, 1, 1, "%lu cycles done", o->cycles);
     if (sf && fclose(sf) && !rc) {
         fprintf(stderr, "shear_flow: error writing %s\n", o->strobe);
         rc = 1;
@@ -184,58 +235,69 @@ static int run_oscillation(odhs_stepper *st, odhs_system *sys, const oscillation
 /* the run at a constant rate to the strain target, an output every `every`;
  * 0 when it reached the target, 3 when it stopped before (jammed; the
  * reason is reported), 1 after an error (reported) */
-static int run_strain(odhs_stepper *st, odhs_system *sys, double strain, double every, int fixed_p, FILE *csv)
+static int run_strain(odhs_stepper *st, odhs_system *sys, double strain, double every, outputs *o)
 {
     int failed = 0;
     printf("%12s %14s %14s %8s %10s%s\n", "strain", "shear_stress", "pressure", "z", "events",
-           fixed_p ? "        phi          kappa" : "");
-    double g0;
+           o->fixed_p ? "        phi          kappa" : "");
+    double g0, t;
     odhs_stepper_strain(st, &g0);
     long nout = (long)ceil(strain / every - 1e-9);
-    for (long k = 0; k <= nout; ++k) {
+    for (long k = 0; k <= nout && !failed; ++k) {
         double target = g0 + fmin(k * every, strain);
         if (k > 0) {
             int rc = odhs_stepper_run_until_strain(st, target);
             if (rc) {
                 double g;
                 odhs_stepper_strain(st, &g);
-                fprintf(stderr, "\nshear_flow: stopped at strain %.6g of %.6g: %s (%s)\n", g - g0, strain,
+                cli_progress_break(&o->prog);
+                fprintf(stderr, "shear_flow: stopped at strain %.6g of %.6g: %s (%s)\n", g - g0, strain,
                         odhs_strerror(rc), odhs_stepper_errmsg(st));
                 failed = rc < 0 ? 1 : 3;
                 break;
             }
         }
-        double g, s, p, z, kappa;
+        double g;
         uint64_t steps, nc, no;
         odhs_stepper_strain(st, &g);
-        odhs_stepper_shear_stress(st, &s);
-        odhs_stepper_pressure(st, &p);
-        odhs_stepper_coordination(st, &z);
-        odhs_stepper_kappa(st, &kappa);
+        odhs_stepper_time(st, &t);
         odhs_stepper_counts(st, &steps, &nc, &no);
-        double phi_now;
-        odhs_system_packing_fraction(sys, &phi_now);
-        unsigned long long ev = (unsigned long long)(nc + no);
-        if (fixed_p) {
-            printf("%12.6f %14.6e %14.6e %8.4f %10llu %10.6f %14.6e\n", g - g0, s, p, z, ev, phi_now, kappa);
-            if (csv) fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g\n", g - g0, s, p, z, ev, phi_now, kappa);
-        } else {
-            printf("%12.6f %14.6e %14.6e %8.4f %10llu\n", g - g0, s, p, z, ev);
-            if (csv) fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu\n", g - g0, s, p, z, ev);
-        }
-        fprintf(stderr, "\rshear_flow: strain %.4f / %.4f, %llu steps, %llu events", g - g0, strain,
-                (unsigned long long)steps, ev);
+        if (output(o, st, sys, g - g0, g - g0, t, 0)) failed = 1;
+        cli_progress_show(&o->prog, g - g0, strain, k == nout, "strain %.4f / %.4f, %llu steps, %llu events", g - g0,
+                          strain, (unsigned long long)steps, (unsigned long long)(nc + no));
     }
-    fprintf(stderr, "\n");
     return failed;
+}
+
+/* the --plot panels: stresses and z against x, under pressure phi and kappa
+ * too (the paper's Figs. 4 and 7) */
+static void plot_init(outputs *o, const char *xlabel, int dim, size_t n, double pressure)
+{
+    char title[160];
+    snprintf(title, sizeof title, "%dD, N = %zu, %s", dim, n, pressure > 0 ? "fixed pressure" : "fixed volume");
+    if (pressure > 0) snprintf(title + strlen(title), sizeof title - strlen(title), " p = %g", pressure);
+    pl_init(&o->panel[0], title, xlabel, "stress (gammadot/xi0)", 0, 0);
+    pl_series_add(&o->panel[0], "shear stress", 0, 0, 0);
+    pl_series_add(&o->panel[0], "pressure", 1, 0, 0);
+    pl_init(&o->panel[1], "", xlabel, "coordination z", 0, 0);
+    pl_series_add(&o->panel[1], "z", 2, 0, 0);
+    o->npanel = 2;
+    if (pressure > 0) {
+        pl_init(&o->panel[2], "", xlabel, "packing fraction", 0, 0);
+        pl_series_add(&o->panel[2], "phi", 3, 0, 0);
+        pl_init(&o->panel[3], "", xlabel, "kappa (compression rate / gammadot)", 0, 0);
+        pl_series_add(&o->panel[3], "kappa", 4, 0, 0);
+        o->npanel = 4;
+    }
 }
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = "cg";
-    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 1e-6;
+    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *traj = NULL, *traj_contacts = NULL, *plot = NULL, *contacts = NULL;
+    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 1e-6, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
-    int dim = 2, integrator = ODHS_INTEGRATOR_EULER, shape = 0;
+    int dim = 2, integrator = CLI_DEFAULT_INTEGRATOR, shape = 0, quiet = 0;
     const char *oscillate = NULL;
     oscillation osc = {0, 0, 4, 40, NULL};
     const cli_opt opts[] = {
@@ -243,8 +305,16 @@ int main(int argc, char **argv)
         CLI_STRAIN(&strain),
         CLI_OUT(&outpath),
         CLI_SVG(&svg),
-        CLI_SERIES(&series, SERIES "; with --pressure also phi,kappa"),
+        CLI_OPT_STRING("--series", &series, "FILE.csv", "write a CSV row per output (the columns below)", CLI_ANY),
+        CLI_OPT_STRING("--plot", &plot, "FILE.svg",
+                       "plot the outputs: stresses and z against strain (time with --oscillate), with --pressure phi "
+                       "and kappa too",
+                       CLI_ANY),
         CLI_EVERY(&every, "strain"),
+        CLI_TRAJ(&traj),
+        CLI_TRAJ_EVERY(&traj_every, "strain (time with --oscillate)"),
+        CLI_TRAJ_CONTACTS(&traj_contacts),
+        CLI_CONTACTS(&contacts),
         CLI_DT(&dt, "strain units"),
         CLI_INTEGRATOR(&integrator),
         CLI_TOL(&tol),
@@ -261,10 +331,15 @@ int main(int argc, char **argv)
                        "with --oscillate: write " STROBE " after every period", CLI_ANY),
         CLI_PHI(&phi),
         CLI_SCENE(&n, &dim, &seed),
+        CLI_QUIET(&quiet),
         CLI_END,
     };
     const cli_spec cli = {"shear_flow", NULL, opts,
-                          "The default solver and integrator, cg and euler, are the paper's choices.\n"
+                          "Series columns: strain, shear_stress, pressure, z, events, phi, kappa, time,\n"
+                          "collisions, openings, dissipation (with --oscillate: time first, then strain,\n"
+                          "...; no second time), after the header a \"# units\" comment line.\n"
+                          "The defaults are the library's (adaptive Heun, the auto solver); paper mode,\n"
+                          "the paper's fixed-step scheme and solver: --integrator euler --solver cg.\n"
                           "Forces are in units of lambda*gammadot/xi0 with lambda the small diameter;\n"
                           "stresses in units of gammadot/xi0 (2D: per length, 3D: per area).\n"
                           "With --pressure P the volume follows the pressure (kappa: compression rate\n"
@@ -298,12 +373,14 @@ int main(int argc, char **argv)
     }
 
     odhs_system *sys = NULL;
-    if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, solver, &sys)) return 1;
+    if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, solver, quiet, &sys)) return 1;
     double phi_now;
     CHECK(odhs_system_packing_fraction(sys, &phi_now));
     n = odhs_system_count(sys);
-    fprintf(stderr, "shear_flow: N = %lu, d = %d, phi = %.6f, solver %s%s\n", n, odhs_system_dim(sys),
-            phi_now, odhs_solver_name(solver), pressure > 0 ? ", fixed pressure" : ", fixed volume");
+    if (!quiet)
+        fprintf(stderr, "shear_flow: N = %lu, d = %d, phi = %.6f, %s, solver %s%s\n", n, odhs_system_dim(sys),
+                phi_now, cli_integrators[integrator], odhs_solver_name(solver),
+                pressure > 0 ? ", fixed pressure" : ", fixed volume");
 
     odhs_driver *drv;
     odhs_stepper *st;
@@ -322,14 +399,33 @@ int main(int argc, char **argv)
     }
 
     FILE *csv;
-    if (cli_series(cli.prog, series, oscillate ? SERIES_OSC : pressure > 0 ? SERIES_P : SERIES, &csv)) return 1;
-    int failed = oscillate ? run_oscillation(st, sys, &osc, csv) : run_strain(st, sys, strain, every, pressure > 0, csv);
+    if (cli_series_units(cli.prog, series, oscillate ? SERIES_OSC : SERIES, UNITS, &csv)) return 1;
+    outputs out = {.csv = csv, .fixed_p = pressure > 0};
+    cli_progress_init(&out.prog, cli.prog, quiet);
+    if ((rc = cli_traj_open(&out.traj, cli.prog, traj, traj_contacts, traj_every))) return rc;
+    if (plot) plot_init(&out, oscillate ? "time (1/gammadot)" : "strain", odhs_system_dim(sys), n, pressure);
+    int failed = oscillate ? run_oscillation(st, sys, &osc, &out) : run_strain(st, sys, strain, every, &out);
     double gap, ov;
     odhs_stepper_errors(st, &gap, &ov);
-    fprintf(stderr, "shear_flow: worst contact gap %.3g, worst overlap %.3g (relative to contact distance)\n",
-            gap, ov);
+    if (!quiet)
+        fprintf(stderr, "shear_flow: worst contact gap %.3g, worst overlap %.3g (relative to contact distance)\n",
+                gap, ov);
     if (csv && fclose(csv)) {
         fprintf(stderr, "shear_flow: error writing %s\n", series);
+        return 1;
+    }
+    if (cli_traj_close(&out.traj)) return 1;
+    if (plot) {
+        const pl_plot *panels[4] = {&out.panel[0], &out.panel[1], &out.panel[2], &out.panel[3]};
+        int bad = pl_write_svg_panels(panels, out.npanel, plot);
+        for (int k = 0; k < out.npanel; ++k) pl_free(&out.panel[k]);
+        if (bad) {
+            fprintf(stderr, "shear_flow: cannot write %s\n", plot);
+            return 1;
+        }
+    }
+    if (contacts && odhs_contacts_write_csv(odhs_stepper_network(st), sys, contacts)) {
+        fprintf(stderr, "shear_flow: cannot write %s: %s\n", contacts, odhs_network_errmsg(odhs_stepper_network(st)));
         return 1;
     }
     if (svg) {
@@ -339,13 +435,7 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    if (outpath) {
-        rc = odhs_xyz_write(sys, outpath);
-        if (rc) {
-            fprintf(stderr, "shear_flow: cannot write %s: %s\n", outpath, odhs_system_errmsg(sys));
-            return 1;
-        }
-    }
+    if (outpath && cli_write_config(cli.prog, sys, outpath)) return 1;
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(solver);

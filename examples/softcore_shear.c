@@ -10,6 +10,7 @@
  * Build against an installed libodhs:
  *     cc softcore_shear.c $(pkg-config --cflags --libs odhs) -lm -o softcore_shear
  */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,7 +45,7 @@ static int build_scene(int dim, unsigned long n, double phi, unsigned long seed,
         odhs_driver *drv;
         odhs_stepper *st;
         odhs_solver *solver;
-        CHECK(odhs_solver_create_by_name(cli_default_solver(n), &solver));
+        CHECK(odhs_solver_create_by_name(CLI_DEFAULT_SOLVER, &solver));
         CHECK(odhs_driver_create(&drv));
         CHECK(odhs_driver_set_compression_rate(drv, 1.0));
         CHECK(odhs_stepper_create(sys, drv, solver, &st));

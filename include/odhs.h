@@ -17,5 +17,7 @@
 #include "odhs/jamming.h"
 #include "odhs/checkpoint.h"
 #include "odhs/softcore.h"
+#include "odhs/traj.h"
+#include "odhs/lammps.h"
 
 #endif /* ODHS_H */

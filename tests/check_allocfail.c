@@ -417,12 +417,13 @@ typedef struct {
     odhs_driver *drv, *drv2;
     odhs_stepper *st, *st2;
     odhs_softcore *soft;
+    odhs_traj *tr;
     double *b, *g, *x1, *x2, *x3, *x4; /* libc memory, not counted */
     size_t nc;
     unsigned char mark[64];
     odhs_jam_certificate cert;
     double errs[2];
-    char dir[64], path1[128], path2[128];
+    char dir[64], path1[128], path2[128], path3[128];
 } af_fix;
 
 struct af_scenario;
@@ -449,10 +450,12 @@ static void fix_init(af_fix *f)
     AF_ASSERT(mkdtemp(f->dir));
     snprintf(f->path1, sizeof f->path1, "%s/one", f->dir);
     snprintf(f->path2, sizeof f->path2, "%s/two", f->dir);
+    snprintf(f->path3, sizeof f->path3, "%s/three.xyz", f->dir);
 }
 
 static void fix_destroy(af_fix *f)
 {
+    odhs_traj_close(f->tr);
     odhs_softcore_destroy(f->soft);
     odhs_stepper_destroy(f->st2);
     odhs_stepper_destroy(f->st);
@@ -995,6 +998,63 @@ static void files_capture(const af_fix *f, const af_scenario *sc, int op, af_buf
 
 static void files_final(af_fix *f, const af_scenario *sc) { check_network(f->net, sc->name); }
 
+/* -- outputs: contacts CSV, LAMMPS data file written and read, a trajectory
+ * of two frames with velocities, read back ----------------------------------- */
+static void outputs_setup(af_fix *f, const af_scenario *sc)
+{
+    files_setup(f, sc);
+    AF_OK(odhs_solver_create_by_name("dense", &f->sol));
+    AF_OK(odhs_driver_create(&f->drv));
+    AF_OK(odhs_driver_set_shear_rate(f->drv, 1.0));
+    AF_OK(odhs_stepper_create(f->sys, f->drv, f->sol, &f->st));
+    AF_OK(odhs_stepper_reset(f->st));
+}
+
+static int outputs_op(af_fix *f, const af_scenario *sc, int k)
+{
+    (void)sc;
+    int s;
+    switch (k) {
+    case 0: return odhs_contacts_write_csv(f->net, f->sys, f->path1);
+    case 1: return odhs_lammps_data_write(f->sys, f->path2);
+    case 2: return odhs_lammps_data_read(f->path2, &f->clone, NULL, 0);
+    case 3: return odhs_traj_open(f->path3, ODHS_TRAJ_XYZ, &f->tr, NULL, 0);
+    case 4:
+    case 5: return odhs_traj_write(f->tr, f->sys, f->st);
+    case 6:
+        s = odhs_traj_close(f->tr);
+        f->tr = NULL;
+        return s;
+    case 7: return odhs_xyz_read_frame(f->path3, -1, &f->sys2, NULL, NULL, 0);
+    }
+    return ODHS_E_INTERNAL;
+}
+
+static void outputs_capture(const af_fix *f, const af_scenario *sc, int op, af_buf *b)
+{
+    (void)sc;
+    (void)op;
+    rec_system(b, "sys", f->sys);
+    rec_system(b, "data", f->clone);
+    rec_system(b, "frame", f->sys2);
+    rec_dir(b, f->dir);
+    rec_file(b, "csv", f->path1);
+    rec_file(b, "lammps", f->path2);
+    rec_file(b, "traj", f->path3);
+}
+
+static void outputs_final(af_fix *f, const af_scenario *sc)
+{
+    (void)sc;
+    uint64_t bad = 0;
+    double x[64], y[64];
+    AF_ASSERT(f->sys2 && f->clone);
+    odhs_system_get_positions(f->sys, x);
+    odhs_system_get_positions(f->sys2, y);
+    for (int k = 0; k < 64; ++k) bad += x[k] != y[k];
+    AF_ASSERT(bad == 0);
+}
+
 /* -- checkpoint: save a running stepper, restore it, step both -------------- */
 static void ckpt_setup(af_fix *f, const af_scenario *sc)
 {
@@ -1308,6 +1368,7 @@ static const af_scenario scenarios[] = {
     {"shear_pressure_high", SH_NOPS, 5, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
+    {"outputs", 8, 0, outputs_setup, NULL, outputs_op, outputs_capture, outputs_final},
     {"checkpoint", 3, 0, ckpt_setup, NULL, ckpt_op, ckpt_capture, ckpt_final},
     {"softcore", SC_NOPS, 0, soft_setup, NULL, soft_op, soft_capture, soft_final},
 };

@@ -1874,6 +1874,129 @@ static int huge_rate_case(void)
     X(contacts_nowhere, odhs_contacts_write, ODHS_E_IO, NOALT, H_NET2, 0,                                      \
       return odhs_contacts_write(w->net2, w->sys2, NOWHERE);)
 
+/* ---- traj.h, lammps.h and the outputs of 0.2.6 in io.h and stepper.h ------------------ */
+/* a trajectory of the given format in the world's directory (NULL: none) */
+static odhs_traj *open_traj(const world *w, int format)
+{
+    odhs_traj *tr = NULL;
+    return odhs_traj_open(wpath(w, "t.xyz"), format, &tr, NULL, 0) ? NULL : tr;
+}
+
+/* status rc of a call on trajectory tr, which must then hold a message; tr closed */
+static int traj_status(odhs_traj *tr, int rc)
+{
+    int empty = !tr || !odhs_traj_errmsg(tr)[0];
+    odhs_traj_close(tr);
+    return !tr ? post("cannot open the trajectory") : empty ? post("no message") : rc;
+}
+
+#define OUTPUT_CASES(X)                                                                                        \
+    STEPPER_OBS_STATE(X, st_external_forces, odhs_stepper_external_forces, 32)                                 \
+    X(contacts_csv_null_net, odhs_contacts_write_csv, ODHS_E_NULL, NOALT, H_NONE, 0,                           \
+      return odhs_contacts_write_csv(NULL, w->sys2, wpath(w, "c.csv"));)                                       \
+    X(contacts_csv_null_sys, odhs_contacts_write_csv, ODHS_E_NULL, NOALT, H_NET2, 0,                           \
+      return odhs_contacts_write_csv(w->net2, NULL, wpath(w, "c.csv"));)                                       \
+    X(contacts_csv_null_path, odhs_contacts_write_csv, ODHS_E_NULL, NOALT, H_NET2, 0,                          \
+      return odhs_contacts_write_csv(w->net2, w->sys2, NULL);)                                                 \
+    X(contacts_csv_dim_mismatch, odhs_contacts_write_csv, ODHS_E_DIM, NOALT, H_NET2, 0,                        \
+      return odhs_contacts_write_csv(w->net2, w->sys3, wpath(w, "c.csv"));)                                    \
+    X(contacts_csv_unset, odhs_contacts_write_csv, ODHS_E_STATE, NOALT, H_NET2, 0,                             \
+      return odhs_contacts_write_csv(w->net2, w->bare, wpath(w, "c.csv"));)                                    \
+    X(contacts_csv_nowhere, odhs_contacts_write_csv, ODHS_E_IO, NOALT, H_NET2, 0,                              \
+      return odhs_contacts_write_csv(w->net2, w->sys2, NOWHERE);)                                              \
+    X(xyz_frame_null_path, odhs_xyz_read_frame, ODHS_E_NULL, NOALT, H_NONE, 0,                                 \
+      odhs_system *s = POISON_PTR(odhs_system); char e[64] = "";                                               \
+      int rc = odhs_xyz_read_frame(NULL, 0, &s, NULL, e, sizeof e);                                            \
+      return s ? post("*out not NULL") : !e[0] ? post("no message") : rc;)                                     \
+    X(xyz_frame_null_out, odhs_xyz_read_frame, ODHS_E_NULL, NOALT, H_NONE, 0,                                  \
+      return odhs_xyz_read_frame(wpath(w, "a.xyz"), 0, NULL, NULL, NULL, 0);)                                  \
+    X(xyz_frame_missing, odhs_xyz_read_frame, ODHS_E_IO, NOALT, H_NONE, 0,                                     \
+      odhs_system *s = POISON_PTR(odhs_system); char e[64] = "";                                               \
+      int rc = odhs_xyz_read_frame(wpath(w, "missing.xyz"), -1, &s, NULL, e, sizeof e);                        \
+      return s ? post("*out not NULL") : !e[0] ? post("no message") : rc;)                                     \
+    X(xyz_frame_range, odhs_xyz_read_frame, ODHS_E_RANGE, NOALT, H_NONE, 0,                                    \
+      if (odhs_xyz_write(w->sys2, wpath(w, "f.xyz"))) return post("cannot write the frame");                  \
+      odhs_system *s = POISON_PTR(odhs_system); char e[128] = ""; long nf = -7;                                \
+      int rc = odhs_xyz_read_frame(wpath(w, "f.xyz"), 1, &s, &nf, e, sizeof e);                               \
+      return s ? post("*out not NULL") : !strstr(e, "1 frame") ? post("message '%s'", e)                     \
+             : nf != -7 ? post("*nframes written on error") : rc;)                                            \
+    X(xyz_frame_range_negative, odhs_xyz_read_frame, ODHS_E_RANGE, NOALT, H_NONE, 0,                           \
+      if (odhs_xyz_write(w->sys2, wpath(w, "f.xyz"))) return post("cannot write the frame");                  \
+      odhs_system *s = POISON_PTR(odhs_system);                                                                \
+      int rc = odhs_xyz_read_frame(wpath(w, "f.xyz"), -2, &s, NULL, NULL, 0);                                  \
+      return s ? post("*out not NULL") : rc;)                                                                  \
+    X(traj_format_null, odhs_traj_format_for, ODHS_E_NULL, NOALT, H_NONE, 0,                                   \
+      int f = 0; return odhs_traj_format_for(NULL, &f);)                                                       \
+    X(traj_format_null_out, odhs_traj_format_for, ODHS_E_NULL, NOALT, H_NONE, 0,                               \
+      return odhs_traj_format_for("a.xyz", NULL);)                                                             \
+    X(traj_format_unknown, odhs_traj_format_for, ODHS_E_INVALID, NOALT, H_NONE, 0,                             \
+      int f = -5; int rc = odhs_traj_format_for("a.xyz.txt", &f);                                              \
+      return f != -5 ? post("*format written on error") : rc;)                                                 \
+    X(traj_open_null_out, odhs_traj_open, ODHS_E_NULL, NOALT, H_NONE, 0,                                       \
+      return odhs_traj_open(wpath(w, "t.xyz"), ODHS_TRAJ_XYZ, NULL, NULL, 0);)                                 \
+    X(traj_open_null_path, odhs_traj_open, ODHS_E_NULL, NOALT, H_NONE, 0,                                      \
+      odhs_traj *t = POISON_PTR(odhs_traj); char e[64] = "";                                                   \
+      int rc = odhs_traj_open(NULL, ODHS_TRAJ_XYZ, &t, e, sizeof e);                                           \
+      return t ? post("*out not NULL") : !e[0] ? post("no message") : rc;)                                     \
+    X(traj_open_bad_format, odhs_traj_open, ODHS_E_INVALID, NOALT, H_NONE, 0,                                  \
+      odhs_traj *t = POISON_PTR(odhs_traj); char e[64] = "";                                                   \
+      int rc = odhs_traj_open(wpath(w, "t.xyz"), 3, &t, e, sizeof e);                                          \
+      return t ? post("*out not NULL") : !e[0] ? post("no message")                                          \
+             : access(wpath(w, "t.xyz"), F_OK) == 0 ? post("file created on error") : rc;)                    \
+    X(traj_open_nowhere, odhs_traj_open, ODHS_E_IO, NOALT, H_NONE, 0,                                          \
+      odhs_traj *t = POISON_PTR(odhs_traj); char e[128] = "";                                                  \
+      int rc = odhs_traj_open(NOWHERE, ODHS_TRAJ_LAMMPS_DUMP, &t, e, sizeof e);                                \
+      return t ? post("*out not NULL") : !strstr(e, NOWHERE) ? post("message '%s'", e) : rc;)                \
+    X(traj_write_null, odhs_traj_write, ODHS_E_NULL, NOALT, H_NONE, 0,                                         \
+      return odhs_traj_write(NULL, w->sys2, NULL);)                                                            \
+    X(traj_write_null_sys, odhs_traj_write, ODHS_E_NULL, NOALT, H_NONE, 0,                                     \
+      odhs_traj *t = open_traj(w, ODHS_TRAJ_XYZ); return traj_status(t, t ? odhs_traj_write(t, NULL, NULL) : 0);) \
+    X(traj_write_other_system, odhs_traj_write, ODHS_E_INVALID, NOALT, H_NONE, 0,                              \
+      odhs_traj *t = open_traj(w, ODHS_TRAJ_XYZ);                                                              \
+      return traj_status(t, t ? odhs_traj_write(t, w->sys3, w->st) : 0);)                                      \
+    X(traj_write_unset, odhs_traj_write, ODHS_E_STATE, NOALT, H_NONE, 0,                                       \
+      odhs_traj *t = open_traj(w, ODHS_TRAJ_LAMMPS_DUMP);                                                      \
+      return traj_status(t, t ? odhs_traj_write(t, w->bare, NULL) : 0);)                                       \
+    X(traj_write_local_no_stepper, odhs_traj_write, ODHS_E_NULL, NOALT, H_NONE, 0,                             \
+      odhs_traj *t = open_traj(w, ODHS_TRAJ_LAMMPS_LOCAL);                                                     \
+      return traj_status(t, t ? odhs_traj_write(t, w->sys2, NULL) : 0);)                                       \
+    X(traj_frames_null, odhs_traj_frames, ODHS_E_NULL, NOALT, H_NONE, 0,                                       \
+      uint64_t c = 0; return odhs_traj_frames(NULL, &c);)                                                      \
+    X(traj_frames_null_out, odhs_traj_frames, ODHS_E_NULL, NOALT, H_NONE, 0,                                   \
+      odhs_traj *t = open_traj(w, ODHS_TRAJ_XYZ); int rc = odhs_traj_frames(t, NULL);                          \
+      odhs_traj_close(t); return t ? rc : post("cannot open the trajectory");)                                 \
+    X(traj_errmsg_null, odhs_traj_errmsg, ODHS_OK, NOALT, H_NONE, 0,                                           \
+      const char *m = odhs_traj_errmsg(NULL); return m && !m[0] ? ODHS_OK : post("not an empty string");)     \
+    X(traj_close_null, odhs_traj_close, ODHS_OK, NOALT, H_NONE, 0, return odhs_traj_close(NULL);)              \
+    X(lammps_write_null_sys, odhs_lammps_data_write, ODHS_E_NULL, NOALT, H_NONE, 0,                            \
+      return odhs_lammps_data_write(NULL, wpath(w, "a.data"));)                                                \
+    X(lammps_write_null_path, odhs_lammps_data_write, ODHS_E_NULL, NOALT, H_SYS2, 0,                           \
+      return odhs_lammps_data_write(w->sys2, NULL);)                                                           \
+    X(lammps_write_unset, odhs_lammps_data_write, ODHS_E_STATE, NOALT, H_BARE, 0,                              \
+      int rc = odhs_lammps_data_write(w->bare, wpath(w, "bare.data"));                                         \
+      return access(wpath(w, "bare.data"), F_OK) == 0 ? post("file written on error") : rc;)                  \
+    X(lammps_write_nowhere, odhs_lammps_data_write, ODHS_E_IO, NOALT, H_SYS2, 0,                               \
+      return odhs_lammps_data_write(w->sys2, NOWHERE);)                                                        \
+    X(lammps_read_null_path, odhs_lammps_data_read, ODHS_E_NULL, NOALT, H_NONE, 0,                             \
+      odhs_system *s = POISON_PTR(odhs_system); char e[64] = "";                                               \
+      int rc = odhs_lammps_data_read(NULL, &s, e, sizeof e);                                                   \
+      return s ? post("*out not NULL") : !e[0] ? post("no message") : rc;)                                     \
+    X(lammps_read_null_out, odhs_lammps_data_read, ODHS_E_NULL, NOALT, H_NONE, 0,                              \
+      return odhs_lammps_data_read(wpath(w, "a.data"), NULL, NULL, 0);)                                        \
+    X(lammps_read_missing, odhs_lammps_data_read, ODHS_E_IO, NOALT, H_NONE, 0,                                 \
+      odhs_system *s = POISON_PTR(odhs_system); char e[64] = "";                                               \
+      int rc = odhs_lammps_data_read(wpath(w, "missing.data"), &s, e, sizeof e);                               \
+      return s ? post("*out not NULL") : !e[0] ? post("no message") : rc;)                                     \
+    X(lammps_parse_null_buf, odhs_lammps_data_parse, ODHS_E_NULL, NOALT, H_NONE, 0,                            \
+      odhs_system *s = POISON_PTR(odhs_system); int rc = odhs_lammps_data_parse(NULL, 0, &s, NULL, 0);         \
+      return s ? post("*out not NULL") : rc;)                                                                  \
+    X(lammps_parse_null_out, odhs_lammps_data_parse, ODHS_E_NULL, NOALT, H_NONE, 0,                            \
+      return odhs_lammps_data_parse("x", 1, NULL, NULL, 0);)                                                   \
+    X(lammps_parse_empty, odhs_lammps_data_parse, ODHS_E_FORMAT, NOALT, H_NONE, 0,                             \
+      odhs_system *s = POISON_PTR(odhs_system); char e[64] = "";                                               \
+      int rc = odhs_lammps_data_parse("", 0, &s, e, sizeof e);                                                 \
+      return s ? post("*out not NULL") : !strstr(e, "line 1") ? post("message '%s'", e) : rc;)
+
 /* ---- checkpoint.h ------------------------------------------------------------------ */
 #define CHECKPOINT_CASES(X)                                                                                    \
     X(ckpt_write_null, odhs_checkpoint_write, ODHS_E_NULL, NOALT, H_NONE, 0,                                   \
@@ -2164,6 +2287,7 @@ STEPPER_CASES(X_DEFINE)
 JAMMING_CASES(X_DEFINE)
 CHECKPOINT_CASES(X_DEFINE)
 SOFTCORE_CASES(X_DEFINE)
+OUTPUT_CASES(X_DEFINE)
 REGRESSION_CASES(X_DEFINE)
 
 static const bad_case common_cases[] = {COMMON_CASES(X_ROW)};
@@ -2176,6 +2300,7 @@ static const bad_case stepper_cases[] = {STEPPER_CASES(X_ROW)};
 static const bad_case jamming_cases[] = {JAMMING_CASES(X_ROW)};
 static const bad_case checkpoint_cases[] = {CHECKPOINT_CASES(X_ROW)};
 static const bad_case softcore_cases[] = {SOFTCORE_CASES(X_ROW)};
+static const bad_case output_cases[] = {OUTPUT_CASES(X_ROW)};
 static const bad_case regression_cases[] = {REGRESSION_CASES(X_ROW)};
 
 #define NROWS(t) ((int)(sizeof t / sizeof t[0]))
@@ -2189,6 +2314,7 @@ static const struct {
     {solver_cases, NROWS(solver_cases)},   {driver_cases, NROWS(driver_cases)},
     {stepper_cases, NROWS(stepper_cases)}, {jamming_cases, NROWS(jamming_cases)},
     {checkpoint_cases, NROWS(checkpoint_cases)}, {softcore_cases, NROWS(softcore_cases)},
+    {output_cases, NROWS(output_cases)},
     {regression_cases, NROWS(regression_cases)},
 };
 
@@ -2264,6 +2390,7 @@ TABLE_TEST(test_stepper, stepper_cases)
 TABLE_TEST(test_jamming, jamming_cases)
 TABLE_TEST(test_checkpoint, checkpoint_cases)
 TABLE_TEST(test_softcore, softcore_cases)
+TABLE_TEST(test_output, output_cases)
 TABLE_TEST(test_regression, regression_cases)
 
 /* ---- coverage: every function declared in the public headers has a row ----- */
@@ -2362,6 +2489,7 @@ Suite *make_badinput_suite(void)
         {"stepper", test_stepper, NROWS(stepper_cases)},    {"jamming", test_jamming, NROWS(jamming_cases)},
         {"checkpoint", test_checkpoint, NROWS(checkpoint_cases)},
         {"softcore", test_softcore, NROWS(softcore_cases)},
+        {"output", test_output, NROWS(output_cases)},
         {"regression", test_regression, NROWS(regression_cases)},
     };
     for (size_t k = 0; k < sizeof tcs / sizeof tcs[0]; ++k) {

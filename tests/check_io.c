@@ -20,84 +20,12 @@
 #include "odhs.h"
 #include "internal.h"
 
-/* ---- fixture: a private temporary directory per test ------------------- */
+/* ---- fixture: a private temporary directory per test (tmpfiles.h) ----- */
+#include "tmpfiles.h"
 
-static char tmpdir[64];
+static void io_setup(void) { tmpdir_make("io"); }
 
-static void io_setup(void)
-{
-    strcpy(tmpdir, "/tmp/odhs-io-XXXXXX");
-    ck_assert_ptr_nonnull(mkdtemp(tmpdir));
-}
-
-static void io_teardown(void)
-{
-    DIR *d = opendir(tmpdir);
-    if (d) {
-        struct dirent *e;
-        char p[512];
-        while ((e = readdir(d)) != NULL) {
-            if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
-            snprintf(p, sizeof p, "%s/%s", tmpdir, e->d_name);
-            chmod(p, 0700);
-            if (remove(p) != 0) {
-                /* a sub-directory made by a test */
-                rmdir(p);
-            }
-        }
-        closedir(d);
-    }
-    chmod(tmpdir, 0700);
-    rmdir(tmpdir);
-}
-
-static void tmppath(char *buf, size_t size, const char *name)
-{
-    snprintf(buf, size, "%s/%s", tmpdir, name);
-}
-
-static void write_text(const char *path, const char *text, size_t len)
-{
-    FILE *f = fopen(path, "wb");
-    ck_assert_ptr_nonnull(f);
-    ck_assert_uint_eq(fwrite(text, 1, len, f), len);
-    ck_assert_int_eq(fclose(f), 0);
-}
-
-/* whole file into a malloc'ed NUL-ended buffer */
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    ck_assert_ptr_nonnull(f);
-    size_t cap = 1 << 16, n = 0;
-    char *b = malloc(cap);
-    ck_assert_ptr_nonnull(b);
-    size_t got;
-    while ((got = fread(b + n, 1, cap - n - 1, f)) > 0) {
-        n += got;
-        if (cap - n - 1 == 0) {
-            cap *= 2;
-            b = realloc(b, cap);
-            ck_assert_ptr_nonnull(b);
-        }
-    }
-    fclose(f);
-    b[n] = '\0';
-    if (len) *len = n;
-    return b;
-}
-
-static int count_dir_entries(void)
-{
-    DIR *d = opendir(tmpdir);
-    ck_assert_ptr_nonnull(d);
-    int c = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) c++;
-    closedir(d);
-    return c;
-}
+static void io_teardown(void) { tmpdir_remove(); }
 
 /* Parse from an exact-size heap copy (no terminating NUL, so a reader that
  * runs past len is caught by ASan/valgrind). */

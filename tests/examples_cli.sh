@@ -18,6 +18,8 @@ expect() { # expect CODE DESCRIPTION -- command...
 expect_in() { # expect_in FILE PATTERN DESCRIPTION
     if grep -q -- "$2" "$tmp/$1"; then pass=$((pass + 1)); else echo "FAIL: $3"; fail=$((fail + 1)); fi
 }
+# data rows of a series file (the header and the "# units" comment left out)
+rows() { grep -v '^#' "$tmp/$1" | tail -n +2 | wc -l; }
 for prog in shear_flow compress self_propulsion; do
     expect 0 "$prog --help" -- "$bin/$prog" --help
     expect_in out "usage: $prog" "$prog --help prints usage"
@@ -39,14 +41,16 @@ expect_in c.csv "^phi,pressure,z,events" "compress writes its series header"
 expect 0 "shear_flow from a file" -- "$bin/shear_flow" --in "$tmp/c.xyz" --strain 0.02 --every 0.01 \
     --out "$tmp/s.xyz" --series "$tmp/s.csv"
 expect_in s.csv "^strain,shear_stress,pressure,z,events" "shear_flow writes its series header"
-[ "$(wc -l < "$tmp/s.csv")" -eq 4 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow series rows"; fail=$((fail + 1)); }
+[ "$(rows s.csv)" -eq 3 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow series rows"; fail=$((fail + 1)); }
 expect 0 "shear_flow at fixed pressure" -- "$bin/shear_flow" --in "$tmp/s.xyz" --strain 0.01 --pressure 5 \
     --series "$tmp/p.csv"
-expect_in p.csv "^strain,shear_stress,pressure,z,events,phi,kappa$" "shear_flow --pressure series has phi and kappa"
-expect 0 "shear_flow --pressure 1000 with the default cg (auto rescues it)" -- "$bin/shear_flow" --n 48 \
-    --pressure 1000 --strain 0.02
+expect_in p.csv "^strain,shear_stress,pressure,z,events,phi,kappa,time,collisions,openings,dissipation$" \
+    "shear_flow --pressure series has phi and kappa"
+expect_in p.csv "^# units: " "shear_flow series states its units in a comment line"
+expect 0 "shear_flow --pressure 1000 with cg (auto rescues it)" -- "$bin/shear_flow" --n 48 \
+    --pressure 1000 --strain 0.02 --solver cg --integrator euler
 expect_in out "phi          kappa" "shear_flow --pressure table has phi and kappa"
-[ "$(awk -F, 'NR > 1 && NF != 7' "$tmp/p.csv" | wc -l)" -eq 0 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --pressure rows have 7 fields"; fail=$((fail + 1)); }
+[ "$(grep -v '^#' "$tmp/p.csv" | awk -F, 'NF != 11' | wc -l)" -eq 0 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --pressure rows have 11 fields"; fail=$((fail + 1)); }
 expect 0 "shear_flow svg" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --svg "$tmp/s.svg"
 head -c 4 "$tmp/s.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: shear_flow svg"; fail=$((fail + 1)); }
 grep -q "<line" "$tmp/s.svg" && pass=$((pass + 1)) || { echo "FAIL: shear_flow svg has no force lines"; fail=$((fail + 1)); }
@@ -59,7 +63,7 @@ expect 2 "shear_flow bad tol" -- "$bin/shear_flow" --tol 2
 expect 0 "shear_flow oscillate" -- "$bin/shear_flow" --in "$tmp/c.xyz" --oscillate 0.05,1,triangle --cycles 2 --solver dense \
     --per-cycle 4 --integrator heun --series "$tmp/o.csv" --strobe "$tmp/strobe.csv"
 expect_in o.csv "^time,strain,shear_stress,pressure,z,events" "shear_flow --oscillate writes its series header"
-[ "$(wc -l < "$tmp/o.csv")" -eq 10 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --oscillate series rows"; fail=$((fail + 1)); }
+[ "$(rows o.csv)" -eq 9 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --oscillate series rows"; fail=$((fail + 1)); }
 expect_in strobe.csv "^cycle,strobe_rms,from_start,events" "shear_flow --strobe header"
 [ "$(wc -l < "$tmp/strobe.csv")" -eq 3 ] && pass=$((pass + 1)) || { echo "FAIL: shear_flow --strobe rows"; fail=$((fail + 1)); }
 expect_in out "^# cycle 2: stroboscopic rms displacement" "shear_flow --oscillate reports the stroboscopic displacement"
@@ -89,7 +93,8 @@ head -c 4 "$tmp/j.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: j
 expect 3 "shear_flow on a jammed packing stops early" -- "$bin/shear_flow" --in "$tmp/j.xyz" --strain 0.1 --solver dense
 expect_in err "^shear_flow: stopped at strain" "shear_flow says why it stopped, on a line of its own"
 expect 2 "jam_packing negative --jam-pressure" -- "$bin/jam_packing" --jam-pressure -1
-grep -q "^# libodhs contacts" "$tmp/j.con" && pass=$((pass + 1)) || { echo "FAIL: jam_packing contacts"; fail=$((fail + 1)); }
+head -1 "$tmp/j.con" | grep -q "^i,j,kind,force,gap$" && [ "$(awk -F, 'NR > 1 && NF != 5' "$tmp/j.con" | wc -l)" -eq 0 ] \
+    && pass=$((pass + 1)) || { echo "FAIL: jam_packing contacts CSV"; fail=$((fail + 1)); }
 expect 0 "composite help" -- "$bin/composite" --help
 expect_in out "usage: composite" "composite --help prints usage"
 expect 2 "composite bad beads" -- "$bin/composite" --beads 5
@@ -110,7 +115,7 @@ head -c 4 "$tmp/h.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: h
 # sweep_serial: examples/mpi/sweep_mpi.c built without MPI (its MPI twin is
 # exercised by make check-mpi)
 expect 0 "sweep_serial help" -- "$bin/sweep_serial" --help
-expect_in out "usage: sweep_mpi" "sweep_serial --help prints usage"
+expect_in out "usage: sweep_serial" "sweep_serial --help prints usage"
 expect 2 "sweep_serial unknown option" -- "$bin/sweep_serial" --no-such-option
 expect 2 "sweep_serial missing value" -- "$bin/sweep_serial" --out
 expect 2 "sweep_serial bad every" -- "$bin/sweep_serial" --every -1
@@ -156,8 +161,12 @@ done
 for prog in shear_flow compress self_propulsion composite hopper jam_packing; do
     "$bin/$prog" --help > "$tmp/out"
     expect_in out "^  --seed S  *random seed (default 1)$" "$prog --seed reads as in the other examples"
-    expect_in out "^  --solver NAME  *linear solver: cg, dense, cholmod, cholmod-pcg, spqr$" "$prog --solver reads as in the other examples"
-    expect_in out "^  --out FILE.xyz  *write the final configuration (extended XYZ)$" "$prog --out reads as in the other examples"
+    expect_in out "^  --solver NAME  *linear solver: auto (a direct" \
+        "$prog --solver reads as in the other examples"
+    grep -A4 -- "--solver NAME" "$tmp/out" | grep -q "(default auto)$" && pass=$((pass + 1)) \
+        || { echo "FAIL: $prog --solver defaults to auto"; fail=$((fail + 1)); }
+    expect_in out "^  --out FILE.xyz  *write the final configuration (extended XYZ; a LAMMPS" \
+        "$prog --out reads as in the other examples"
 done
 for prog in shear_flow compress self_propulsion jam_packing softcore_shear; do
     "$bin/$prog" --help > "$tmp/out"
@@ -174,6 +183,102 @@ expect 2 "jam_packing missing value" -- "$bin/jam_packing" --seed
 expect_in err "^jam_packing: unknown option or missing value: --seed$" "jam_packing names the option without a value"
 expect 2 "softcore_shear bad integrator" -- "$bin/softcore_shear" --integrator heun
 expect 2 "sweep_serial unknown solver usage" -- "$bin/sweep_serial" --solver nonsense
-expect_in err "(default cholmod when built in, else cg)" "sweep_serial usage after a bad solver shows the default"
+expect_in err "(default auto)" "sweep_serial usage after a bad solver shows the default"
+# ---- what users look at (issue 20): library defaults, trajectories, files
+# for other tools, plots, progress lines
+py=$(command -v /usr/bin/python3 || command -v python3)
+check_py() { # check_py DESCRIPTION ARGS...: 0 pass, 77 skipped (said why), else fail
+    local what=$1; shift
+    if [ -z "$py" ]; then echo "skipped: $what: no python3"; return; fi
+    "$py" "$(dirname "$0")/outputs_check.py" "$@" > "$tmp/py" 2>&1
+    local got=$?
+    if [ "$got" -eq 0 ]; then pass=$((pass + 1))
+    elif [ "$got" -eq 77 ]; then echo "skipped: $what: $(cat "$tmp/py")"
+    else echo "FAIL: $what"; sed 's/^/  | /' "$tmp/py" | tail -5; fail=$((fail + 1)); fi
+}
+for s in 1 2 3; do
+    expect 0 "shear_flow defaults --n 100 --phi 0.82 --strain 2 --seed $s" -- "$bin/shear_flow" --n 100 --phi 0.82 \
+        --strain 2 --every 0.005 --seed $s
+done
+expect_in err "heun, solver auto" "shear_flow runs the library's defaults (heun, auto)"
+grep -q $'\r' "$tmp/err" && { echo "FAIL: progress lines end in CR when stderr is a file"; fail=$((fail + 1)); } \
+    || pass=$((pass + 1))
+expect 0 "shear_flow --quiet" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --quiet
+[ -s "$tmp/err" ] && { echo "FAIL: shear_flow --quiet writes to stderr"; fail=$((fail + 1)); } || pass=$((pass + 1))
+expect 0 "shear_flow paper mode" -- "$bin/shear_flow" --n 32 --phi 0.6 --strain 0.01 --integrator euler --solver cg
+expect_in err "euler, solver cg" "shear_flow paper mode is one option away"
+# a trajectory never changes the run: the final state is bit-identical
+expect 0 "shear_flow without --traj" -- "$bin/shear_flow" --n 64 --strain 0.1 --every 0.01 --out "$tmp/a.xyz"
+expect 0 "shear_flow with --traj" -- "$bin/shear_flow" --n 64 --strain 0.1 --every 0.01 --out "$tmp/b.xyz" \
+    --traj "$tmp/t.xyz" --traj-every 0.02 --traj-contacts "$tmp/t.bonds" --contacts "$tmp/t.csv" \
+    --plot "$tmp/plot.svg" --series "$tmp/t_series.csv"
+cmp -s "$tmp/a.xyz" "$tmp/b.xyz" && pass=$((pass + 1)) || { echo "FAIL: --traj changed the run"; fail=$((fail + 1)); }
+[ "$(grep -c '^64$' "$tmp/t.xyz")" -eq 6 ] && pass=$((pass + 1)) || { echo "FAIL: --traj frame count"; fail=$((fail + 1)); }
+[ "$(grep -c '^ITEM: ENTRIES index batom1 batom2 kind force gap$' "$tmp/t.bonds")" -eq 6 ] && pass=$((pass + 1)) \
+    || { echo "FAIL: --traj-contacts frame count"; fail=$((fail + 1)); }
+check_py "trajectory read by ASE" traj "$tmp/t.xyz" 6 64
+check_py "contacts CSV read by numpy" csv "$tmp/t.csv" "$(($(wc -l < "$tmp/t.csv") - 1))"
+check_py "--plot: 3 lines of 11 points" svg "$tmp/plot.svg" 11 3
+expect 0 "shear_flow reads a trajectory (its first frame)" -- "$bin/shear_flow" --in "$tmp/t.xyz" --strain 0.01
+expect 0 "shear_flow --traj LAMMPS dump" -- "$bin/shear_flow" --n 64 --strain 0.02 --traj "$tmp/t.lammpstrj" \
+    --quiet --out "$tmp/c.xyz.tmp"
+[ "$(grep -c '^ITEM: ATOMS id type radius x y z vx vy vz ux uy uz fx fy fz$' "$tmp/t.lammpstrj")" -eq 3 ] \
+    && pass=$((pass + 1)) || { echo "FAIL: LAMMPS dump frames"; fail=$((fail + 1)); }
+expect 0 "shear_flow --pressure --plot" -- "$bin/shear_flow" --n 32 --strain 0.02 --pressure 10 --plot "$tmp/pp.svg"
+check_py "--plot under pressure: 5 lines of 3 points" svg "$tmp/pp.svg" 3 5
+expect 2 "shear_flow --traj of no known format" -- "$bin/shear_flow" --n 32 --traj "$tmp/t.txt"
+expect 2 "shear_flow bad --traj-every" -- "$bin/shear_flow" --traj-every 0
+expect 1 "shear_flow unwritable --traj" -- "$bin/shear_flow" --n 32 --traj "$tmp/no/such/dir/t.xyz"
+expect 1 "shear_flow unwritable --plot" -- "$bin/shear_flow" --n 32 --strain 0.01 --plot "$tmp/no/such/dir/p.svg"
+# LAMMPS data files: --out writes one, --in reads it (and LAMMPS's own, when lmp is installed)
+expect 0 "shear_flow --out LAMMPS data" -- "$bin/shear_flow" --n 64 --strain 0.05 --out "$tmp/s.data"
+expect_in s.data "^Atoms # sphere" "the data file has atom_style sphere atoms"
+expect 0 "shear_flow --in LAMMPS data" -- "$bin/shear_flow" --in "$tmp/s.data" --strain 0.01
+if command -v lmp > /dev/null; then
+    printf 'units lj\ndimension 2\natom_style sphere\nboundary p p p\nread_data %s\nwrite_data %s\n' \
+        "$tmp/s.data" "$tmp/lmp.data" > "$tmp/in.lmp"
+    expect 0 "lmp reads and writes the data file" -- lmp -log none -screen none -in "$tmp/in.lmp"
+    expect 0 "shear_flow --in a data file LAMMPS wrote" -- "$bin/shear_flow" --in "$tmp/lmp.data" --strain 0.01
+else
+    echo "skipped: lmp (Debian lammps) not installed: LAMMPS reading our data file not checked"
+fi
+expect 1 "shear_flow malformed data file" -- "$bin/shear_flow" --in "$tmp/t.csv.data"
+expect 0 "jam_packing --traj" -- "$bin/jam_packing" --n 32 --traj "$tmp/j.xyz" --traj-every 0.05 --out "$tmp/j1.xyz" \
+    --quiet
+expect 0 "jam_packing without --traj" -- "$bin/jam_packing" --n 32 --out "$tmp/j2.xyz" --quiet
+cmp -s "$tmp/j1.xyz" "$tmp/j2.xyz" && pass=$((pass + 1)) || { echo "FAIL: jam_packing --traj changed the run"; fail=$((fail + 1)); }
+[ "$(grep -c Lattice "$tmp/j.xyz")" -ge 3 ] && pass=$((pass + 1)) || { echo "FAIL: jam_packing --traj frames"; fail=$((fail + 1)); }
+# the other examples: the same options, and a trajectory that never changes the run
+declare -A args=(
+    [compress]="--n 48 --phi 0.7 --traj-every 0.05"
+    [composite]="--bodies 20 --beads 2 --phi 0.5 --strain 0.05 --every 0.01 --traj-every 0.02"
+    [hopper]="--n 40 --time 4 --every 1 --traj-every 2"
+    [self_propulsion]="--n 48 --time 1 --every 0.25 --traj-every 0.5"
+)
+for prog in compress composite hopper self_propulsion; do
+    # shellcheck disable=SC2086
+    expect 0 "$prog without --traj" -- "$bin/$prog" ${args[$prog]} --out "$tmp/$prog.a.xyz" --quiet
+    [ -s "$tmp/err" ] && { echo "FAIL: $prog --quiet writes to stderr"; fail=$((fail + 1)); } || pass=$((pass + 1))
+    # shellcheck disable=SC2086
+    expect 0 "$prog with --traj" -- "$bin/$prog" ${args[$prog]} --out "$tmp/$prog.b.xyz" --traj "$tmp/$prog.t.xyz" \
+        --traj-contacts "$tmp/$prog.t.bonds"
+    cmp -s "$tmp/$prog.a.xyz" "$tmp/$prog.b.xyz" && pass=$((pass + 1)) \
+        || { echo "FAIL: $prog --traj changed the run"; fail=$((fail + 1)); }
+    [ "$(grep -c Lattice "$tmp/$prog.t.xyz")" -ge 2 ] && [ "$(grep -c '^ITEM: TIMESTEP' "$tmp/$prog.t.bonds")" -ge 2 ] \
+        && pass=$((pass + 1)) || { echo "FAIL: $prog trajectory frames"; fail=$((fail + 1)); }
+    expect_in err "heun, solver auto" "$prog runs the library's defaults (heun, auto)"
+    grep -q $'\r' "$tmp/err" && { echo "FAIL: $prog progress ends in CR in a file"; fail=$((fail + 1)); } \
+        || pass=$((pass + 1))
+    # shellcheck disable=SC2086
+    expect 0 "$prog paper mode" -- "$bin/$prog" ${args[$prog]} --integrator euler --solver cg --quiet
+    expect 2 "$prog bad --traj-every" -- "$bin/$prog" --traj-every -1
+    expect 0 "$prog --help" -- "$bin/$prog" --help
+    expect_in out "paper mode" "$prog --help names paper mode"
+    expect_in out "^  --traj FILE" "$prog --help lists --traj"
+    expect_in out "^  --quiet" "$prog --help lists --quiet"
+done
+expect 0 "minimal --help" -- "$bin/minimal" --help
+expect_in out "^usage: " "minimal --help prints usage"
+expect 2 "minimal bad option" -- "$bin/minimal" --n 5
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

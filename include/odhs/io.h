@@ -8,11 +8,14 @@
  *   then N lines: species x y z radius
  * with a = (Lx,0,0), b = (gamma*Ly, Ly, 0), c = (0,0,Lz) the sheared cell. In 2D
  * z = 0, c = (0,0,1) and pbc="T T F". Numbers are written with 17 significant
- * digits, so a write/read round trip is bit-exact. OVITO and ASE read these
- * files directly.
+ * digits, so a write/read round trip is bit-exact. OVITO reads these files
+ * directly; ASE reads them only when every species label is a chemical
+ * symbol (it takes the species column for elements): the trajectories of
+ * traj.h name the label column type instead, and ASE reads them as they are.
  *
  * The reader accepts any extended XYZ frame whose Properties contain species
- * (S:1), pos (R:3) and radius (R:1) columns in any order, with other columns
+ * (S:1; or type S:1 when there is no species column), pos (R:3) and radius
+ * (R:1) columns in any order, with other columns
  * ignored; keys may appear in any order; dim defaults to 3, or 2 when pbc's
  * third flag is F; strain defaults to bx/Ly. Orthogonal-cell lattices only
  * (apart from the x-y shear). Malformed input gives ODHS_E_FORMAT with a message
@@ -41,6 +44,19 @@ ODHS_API int odhs_xyz_read(const char *path, odhs_system **out, char *errbuf, si
 /** As odhs_xyz_read, from a memory buffer of len bytes (need not be NUL-ended). */
 ODHS_API int odhs_xyz_parse(const char *buf, size_t len, odhs_system **out, char *errbuf,
                             size_t errlen);
+
+/**
+ * Read frame `frame` (0 = the first; negative counts from the end, -1 = the
+ * last) of a multi-frame extended XYZ file such as a trajectory of
+ * odhs_traj (traj.h), whose label column is named type instead of species.
+ * *nframes (may be NULL) receives the number of frames in the file. Frames
+ * follow each other, each a count line and N + 1 more lines; blank lines
+ * between frames are skipped. Errors: as odhs_xyz_read (messages name the
+ * frame and its first line), and ODHS_E_RANGE when the file has no such
+ * frame. Since 0.2.6.
+ */
+ODHS_API int odhs_xyz_read_frame(const char *path, long frame, odhs_system **out, long *nframes,
+                                 char *errbuf, size_t errlen);
 
 /**
  * Write the system to path in the format above (the file is written to a
@@ -78,6 +94,17 @@ ODHS_API int odhs_svg_write(const odhs_system *sys, const struct odhs_network *n
  * this header.)
  */
 ODHS_API int odhs_contacts_write(const struct odhs_network *net, const odhs_system *sys, const char *path);
+
+/**
+ * Write the contacts of a network as CSV that numpy.genfromtxt(names=True)
+ * and pandas.read_csv read as they are: the header row "i,j,kind,force,gap",
+ * then one row per contact with the particles i < j (user order; a contact
+ * with wall w has j = N + w), its kind (ODHS_CONTACT_TEMPORARY 0, PERMANENT 1,
+ * WALL 2), the force and the gap (17 significant digits). No comment lines.
+ * Written atomically. Errors: as odhs_contacts_write. Since 0.2.6.
+ */
+ODHS_API int odhs_contacts_write_csv(const struct odhs_network *net, const odhs_system *sys,
+                                     const char *path);
 
 #ifdef __cplusplus
 }

@@ -192,6 +192,13 @@ ODHS_API int odhs_stepper_power(const odhs_stepper *st, double *P);
 ODHS_API int odhs_stepper_velocities(const odhs_stepper *st, double *V);
 /** Non-affine velocities V - V_aff (N*dim). */
 ODHS_API int odhs_stepper_nonaffine_velocities(const odhs_stepper *st, double *U);
+/**
+ * The external force on each particle (N*dim) in the state the observables
+ * describe: the driver's fixed forces, the force callback's output, gravity
+ * and self-propulsion summed (not the contact forces); zeros when the scene
+ * has none. Since 0.2.6.
+ */
+ODHS_API int odhs_stepper_external_forces(const odhs_stepper *st, double *F);
 /** Mean coordination z = 2 Nc / N. */
 ODHS_API int odhs_stepper_coordination(const odhs_stepper *st, double *z);
 /** Optional features whose code a scene runs only when it uses them (pinned

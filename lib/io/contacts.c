@@ -1,26 +1,15 @@
-/* libodhs - I/O: the contacts file of a network (pairs, image shifts, force, gap). */
+/* libodhs - I/O: the contacts file of a network, as text with image shifts
+ * (odhs_contacts_write) or as CSV (odhs_contacts_write_csv). */
 #include <stdio.h>
 #include <string.h>
 
 #include "network/network.h"
 
-int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const char *path)
+/* one writer's body: 0 on success */
+typedef int (*body_fn)(FILE *f, const odhs_network *net, const odhs_system *sys);
+
+static int body_text(FILE *f, const odhs_network *net, const odhs_system *sys)
 {
-    if (!net) return ODHS_E_NULL;
-    if (!sys || !path) return odhs__neterr(net, ODHS_E_NULL, "NULL argument");
-    if (sys->n != net->n || sys->dim != net->dim)
-        return odhs__neterr(net, ODHS_E_DIM, "system and network differ in N or dimension");
-    if (!sys->has_x || !sys->has_r) return odhs__neterr(net, ODHS_E_STATE, "system radii and positions unset");
-    size_t len = strlen(path);
-    char *tmp = odhs__malloc(len + 32);
-    if (!tmp) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
-    snprintf(tmp, len + 32, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        int e = odhs__neterr(net, ODHS_E_IO, "cannot write %s", tmp);
-        odhs__free(tmp);
-        return e;
-    }
     int d = net->dim, ok = 1;
     ok &= fprintf(f, "# libodhs contacts N=%zu dim=%d Nc=%zu\n", net->n, d, net->nc) > 0;
     ok &= fprintf(f, "# i j %s force gap\n", d == 2 ? "s0 s1" : "s0 s1 s2") > 0;
@@ -38,6 +27,38 @@ int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const c
             ok &= fprintf(f, "%zu %zu %d %d %d %.17g %.17g\n", i, j, img[0], img[1], img[2], net->f[c],
                           net->gap[c]) > 0;
     }
+    return ok ? 0 : -1;
+}
+
+static int body_csv(FILE *f, const odhs_network *net, const odhs_system *sys)
+{
+    (void)sys;
+    int ok = fprintf(f, "i,j,kind,force,gap\n") > 0;
+    for (size_t c = 0; c < net->nc && ok; ++c)
+        ok &= fprintf(f, "%zu,%zu,%d,%.17g,%.17g\n", net->ci[c], net->cj[c], (int)net->kind[c], net->f[c],
+                      net->gap[c]) > 0;
+    return ok ? 0 : -1;
+}
+
+/* the checks, then body into a temporary file renamed to path */
+static int write_file(const odhs_network *net, const odhs_system *sys, const char *path, body_fn body)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!sys || !path) return odhs__neterr(net, ODHS_E_NULL, "NULL argument");
+    if (sys->n != net->n || sys->dim != net->dim)
+        return odhs__neterr(net, ODHS_E_DIM, "system and network differ in N or dimension");
+    if (!sys->has_x || !sys->has_r) return odhs__neterr(net, ODHS_E_STATE, "system radii and positions unset");
+    size_t len = strlen(path);
+    char *tmp = odhs__malloc(len + 32);
+    if (!tmp) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
+    snprintf(tmp, len + 32, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        int e = odhs__neterr(net, ODHS_E_IO, "cannot write %s", tmp);
+        odhs__free(tmp);
+        return e;
+    }
+    int ok = body(f, net, sys) == 0;
     ok &= fflush(f) == 0;
     ok &= fclose(f) == 0;
     if (!ok || rename(tmp, path) != 0) {
@@ -48,4 +69,14 @@ int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const c
     }
     odhs__free(tmp);
     return ODHS_OK;
+}
+
+int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const char *path)
+{
+    return write_file(net, sys, path, body_text);
+}
+
+int odhs_contacts_write_csv(const odhs_network *net, const odhs_system *sys, const char *path)
+{
+    return write_file(net, sys, path, body_csv);
 }

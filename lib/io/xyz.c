@@ -23,14 +23,12 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-#include "system/system.h"
+#include "io/text.h"
 
 #define ODHS_XYZ_OVERLAP_ACCEPT 1e-4 /* relative overlap accepted when reading */
 
@@ -39,27 +37,8 @@
 #define XYZ_N_MAX ((size_t)100000000)
 /* Largest total number of columns in a Properties specification. */
 #define XYZ_COLS_MAX ((size_t)100000)
-/* Longest numeric token accepted. */
-#define XYZ_NUM_MAX 255
 
-/* ---- small helpers -------------------------------------------------------- */
-
-typedef struct {
-    const char *p;
-    size_t n;
-} span;
-
-typedef struct {
-    const char *buf;
-    size_t len;
-    size_t pos;
-    size_t lineno; /* 1-based number of the line last returned */
-} reader;
-
-static int is_ws(char c)
-{
-    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-}
+/* ---- small helpers (the shared ones are in io/text.h) ----------------------- */
 
 static char to_lower(char c)
 {
@@ -73,113 +52,6 @@ static int span_ieq(span s, const char *lit)
     if (s.n != k) return 0;
     for (size_t i = 0; i < k; i++)
         if (to_lower(s.p[i]) != to_lower(lit[i])) return 0;
-    return 1;
-}
-
-/* Next line (without '\n' and a trailing '\r'); 0 at the end of the buffer. */
-static int next_line(reader *rd, span *line)
-{
-    if (rd->pos >= rd->len) return 0;
-    const char *start = rd->buf + rd->pos;
-    size_t rest = rd->len - rd->pos;
-    const char *nl = memchr(start, '\n', rest);
-    size_t n = nl ? (size_t)(nl - start) : rest;
-    rd->pos += nl ? n + 1 : n;
-    if (n > 0 && start[n - 1] == '\r') n--;
-    line->p = start;
-    line->n = n;
-    rd->lineno++;
-    return 1;
-}
-
-static span trim(span s)
-{
-    while (s.n > 0 && is_ws(s.p[0])) {
-        s.p++;
-        s.n--;
-    }
-    while (s.n > 0 && is_ws(s.p[s.n - 1])) s.n--;
-    return s;
-}
-
-/* Next white-space separated token of s starting at *i; 0 if none left. */
-static int next_token(span s, size_t *i, span *tok)
-{
-    size_t k = *i;
-    while (k < s.n && is_ws(s.p[k])) k++;
-    if (k >= s.n) {
-        *i = k;
-        return 0;
-    }
-    size_t start = k;
-    while (k < s.n && !is_ws(s.p[k])) k++;
-    tok->p = s.p + start;
-    tok->n = k - start;
-    *i = k;
-    return 1;
-}
-
-static size_t count_tokens(span s)
-{
-    size_t i = 0, c = 0;
-    span t;
-    while (next_token(s, &i, &t)) c++;
-    return c;
-}
-
-/* Length to print of a token in a message (tokens can be huge). */
-static int show_len(span s)
-{
-    return (int)(s.n > 40 ? 40 : s.n);
-}
-
-/* Parse a whole token as a double. 0 ok, -1 not a number, -2 not finite. */
-static int parse_double(span tok, double *out)
-{
-    char tmp[XYZ_NUM_MAX + 1];
-    if (tok.n == 0 || tok.n > XYZ_NUM_MAX) return -1;
-    memcpy(tmp, tok.p, tok.n);
-    tmp[tok.n] = '\0';
-    /* strtod would skip leading white space; tokens never have any, but a
-     * value taken from a quoted string might. */
-    if (is_ws(tmp[0]) || tmp[0] == '\n') return -1;
-    char *end = NULL;
-    double v = strtod(tmp, &end);
-    if (end != tmp + tok.n) return -1;
-    if (!isfinite(v)) return -2;
-    *out = v;
-    return 0;
-}
-
-/* Parse a token of decimal digits only as an unsigned count <= max.
- * 0 ok, -1 not a non-negative integer, -2 larger than max. */
-static int parse_count(span tok, size_t max, size_t *out)
-{
-    if (tok.n == 0) return -1;
-    size_t v = 0;
-    int big = 0;
-    for (size_t i = 0; i < tok.n; i++) {
-        char c = tok.p[i];
-        if (c < '0' || c > '9') return -1;
-        if (!big) {
-            v = v * 10 + (size_t)(c - '0');
-            if (v > max) big = 1;
-        }
-    }
-    if (big) return -2;
-    *out = v;
-    return 0;
-}
-
-/* A species label the library accepts: 1..ODHS_SPECIES_MAX printable ASCII
- * characters without white space or quotes. */
-static int valid_label(span s)
-{
-    if (s.n < 1 || s.n > ODHS_SPECIES_MAX) return 0;
-    for (size_t i = 0; i < s.n; i++) {
-        unsigned char c = (unsigned char)s.p[i];
-        if (c <= 0x20 || c >= 0x7f || c == '"' || c == '\'' || c == '=') return 0;
-    }
     return 1;
 }
 
@@ -242,7 +114,8 @@ static int parse_flag(span t, int *flag)
 
 /* Which of the columns species, pos and radius Properties has named. */
 typedef struct {
-    int sp, pos, rad;
+    int sp, pos, rad, type; /* type: a type:S:1 column (the label when species is absent) */
+    size_t col_type;
 } props_seen;
 
 /* The count of the column name:type:count that starts at column *col; the
@@ -287,6 +160,11 @@ static int parse_column(span name, span type, span f, size_t lineno, props_seen 
                              "line %zu: Properties: 'radius' must be R:1", lineno);
         have->rad = 1;
         h->col_rad = *col;
+    } else if (span_ieq(name, "type") && t == 's' && count == 1 && !have->type) {
+        /* trajectories (odhs_traj) name the label column type, so that ASE,
+         * which takes species for chemical symbols, reads them */
+        have->type = 1;
+        have->col_type = *col;
     }
     *col += count;
     return ODHS_OK;
@@ -297,7 +175,7 @@ static int parse_properties(span v, size_t lineno, header *h, char *msg)
 {
     size_t i = 0, field = 0, col = 0;
     span name = {NULL, 0}, type = {NULL, 0};
-    props_seen have = {0, 0, 0};
+    props_seen have = {0, 0, 0, 0, 0};
     for (;;) {
         size_t start = i;
         while (i < v.n && v.p[i] != ':') i++;
@@ -332,9 +210,13 @@ static int parse_properties(span v, size_t lineno, header *h, char *msg)
     if (field % 3 != 0)
         return odhs__err(msg, ODHS_E_FORMAT,
                          "line %zu: Properties: expected name:type:count triplets", lineno);
+    if (!have.sp && have.type) {
+        have.sp = 1;
+        h->col_sp = have.col_type;
+    }
     if (!have.sp || !have.pos || !have.rad)
         return odhs__err(msg, ODHS_E_FORMAT,
-                         "line %zu: Properties must contain species:S:1, pos:R:3 and "
+                         "line %zu: Properties must contain species:S:1 (or type:S:1), pos:R:3 and "
                          "radius:R:1 (missing %s)",
                          lineno, !have.sp ? "species" : !have.pos ? "pos" : "radius");
     h->ncols = col;
@@ -674,8 +556,9 @@ done:
     return st;
 }
 
-static int parse_impl(const char *buf, size_t len, odhs_system **out, char *msg)
+static int parse_impl(const char *buf, size_t len, odhs_system **out, char *msg, void *ctx)
 {
+    (void)ctx;
     reader rd = {buf, len, 0, 0};
     span line;
 
@@ -722,94 +605,81 @@ done:
     return st;
 }
 
-static void copy_msg(char *errbuf, size_t errlen, const char *msg)
-{
-    if (errbuf && errlen > 0) snprintf(errbuf, errlen, "%s", msg);
-}
-
 int odhs_xyz_parse(const char *buf, size_t len, odhs_system **out, char *errbuf, size_t errlen)
 {
-    char msg[ODHS_ERRMSG_LEN];
-    msg[0] = '\0';
-    if (errbuf && errlen > 0) errbuf[0] = '\0';
-    if (out) *out = NULL;
-    if (!out || !buf) {
-        int st = odhs__err(msg, ODHS_E_NULL, "%s is NULL", !out ? "out" : "buf");
-        copy_msg(errbuf, errlen, msg);
-        return st;
-    }
-    int st = parse_impl(buf, len, out, msg);
-    if (st < 0) {
-        *out = NULL;
-        copy_msg(errbuf, errlen, msg);
-    }
-    return st;
+    return odhs__parse_entry(buf, len, out, errbuf, errlen, parse_impl, NULL);
 }
 
 int odhs_xyz_read(const char *path, odhs_system **out, char *errbuf, size_t errlen)
 {
-    char msg[ODHS_ERRMSG_LEN];
-    msg[0] = '\0';
-    if (errbuf && errlen > 0) errbuf[0] = '\0';
-    if (out) *out = NULL;
-    if (!out || !path) {
-        int st = odhs__err(msg, ODHS_E_NULL, "%s is NULL", !out ? "out" : "path");
-        copy_msg(errbuf, errlen, msg);
-        return st;
-    }
-    errno = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        int e = errno;
-        int st = odhs__err(msg, ODHS_E_IO, "cannot open '%s': %s", path,
-                           e ? strerror(e) : "unknown error");
-        copy_msg(errbuf, errlen, msg);
-        return st;
-    }
-    size_t cap = 65536, len = 0;
-    char *data = odhs__malloc(cap);
-    if (!data) {
-        fclose(f);
-        int st = odhs__err(msg, ODHS_E_NOMEM, "out of memory reading '%s'", path);
-        copy_msg(errbuf, errlen, msg);
-        return st;
-    }
+    return odhs__read_entry(path, out, errbuf, errlen, parse_impl, NULL);
+}
+
+/* The frames of a multi-frame file: each starts at a line holding its
+ * particle count N and has N + 1 more lines; blank lines between frames are
+ * skipped. Stores the byte offset and first line of frame `want` (of every
+ * frame in turn when want < 0, so the last one stays); returns the count, or
+ * an error (message in msg) when a frame is cut short or a count is missing. */
+static long scan_frames(const char *buf, size_t len, long want, size_t *off_out, size_t *line_out, char *msg)
+{
+    reader rd = {buf, len, 0, 0};
+    long k = 0;
     for (;;) {
-        if (len == cap) {
-            if (cap > ((size_t)-1) / 2) {
-                fclose(f);
-                odhs__free(data);
-                int st = odhs__err(msg, ODHS_E_NOMEM, "'%s' is too large", path);
-                copy_msg(errbuf, errlen, msg);
-                return st;
-            }
-            char *bigger = odhs__realloc(data, cap * 2);
-            if (!bigger) {
-                fclose(f);
-                odhs__free(data);
-                int st = odhs__err(msg, ODHS_E_NOMEM, "out of memory reading '%s'", path);
-                copy_msg(errbuf, errlen, msg);
-                return st;
-            }
-            data = bigger;
-            cap *= 2;
+        size_t off = rd.pos;
+        span line;
+        if (!next_line(&rd, &line)) break;
+        if (is_blank(line)) continue;
+        size_t n = 0;
+        span t = trim(line);
+        if (parse_count(t, XYZ_N_MAX, &n) != 0 || n == 0)
+            return odhs__err(msg, ODHS_E_FORMAT,
+                             "line %zu: expected the particle count of frame %ld, found '%.*s'", rd.lineno, k,
+                             show_len(t), t.p);
+        size_t first = rd.lineno;
+        if (k == want || want < 0) {
+            *off_out = off;
+            *line_out = first;
         }
-        errno = 0;
-        size_t got = fread(data + len, 1, cap - len, f);
-        len += got;
-        if (got == 0) break;
+        for (size_t i = 0; i < n + 1; ++i)
+            if (!next_line(&rd, &line))
+                return odhs__err(msg, ODHS_E_FORMAT, "frame %ld (line %zu): the file ends after %zu of its %zu lines",
+                                 k, first, i, n + 1);
+        ++k;
     }
-    if (ferror(f)) {
-        int e = errno;
-        fclose(f);
-        odhs__free(data);
-        int st = odhs__err(msg, ODHS_E_IO, "cannot read '%s': %s", path,
-                           e ? strerror(e) : "read error");
-        copy_msg(errbuf, errlen, msg);
-        return st;
+    return k;
+}
+
+typedef struct {
+    long frame, *nframes;
+    const char *path;
+} frame_req;
+
+/* frame req->frame of the file in buf */
+static int parse_frame(const char *buf, size_t len, odhs_system **out, char *msg, void *ctx)
+{
+    const frame_req *req = ctx;
+    /* the first pass counts the frames; the second finds the one wanted */
+    size_t off = 0, line = 0;
+    long count = scan_frames(buf, len, -2, &off, &line, msg);
+    if (count < 0) return (int)count;
+    long k = req->frame < 0 ? count + req->frame : req->frame;
+    if (k < 0 || k >= count)
+        return odhs__err(msg, ODHS_E_RANGE, "'%s' holds %ld frame%s; frame %ld does not exist", req->path, count,
+                         count == 1 ? "" : "s", req->frame);
+    scan_frames(buf, len, k, &off, &line, msg);
+    int st = parse_impl(buf + off, len - off, out, msg, NULL);
+    if (st < 0) {
+        char inner[ODHS_ERRMSG_LEN];
+        memcpy(inner, msg, sizeof inner);
+        return odhs__err(msg, st, "frame %ld (from line %zu): %s", k, line, inner);
     }
-    fclose(f);
-    int st = odhs_xyz_parse(data, len, out, errbuf, errlen);
-    odhs__free(data);
+    if (req->nframes) *req->nframes = count;
     return st;
+}
+
+int odhs_xyz_read_frame(const char *path, long frame, odhs_system **out, long *nframes, char *errbuf,
+                        size_t errlen)
+{
+    frame_req req = {frame, nframes, path};
+    return odhs__read_entry(path, out, errbuf, errlen, parse_frame, &req);
 }

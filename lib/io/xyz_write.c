@@ -9,26 +9,29 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
-#include "system/system.h"
+#include "io/text.h"
 
-/* Makes temporary names unique within the process ("wx" below refuses to
- * open an existing file anyway, so a collision only costs a retry). */
-#if defined(__STDC_NO_ATOMICS__)
-static unsigned long tmp_counter;
-#else
-static _Atomic unsigned long tmp_counter;
-#endif
+typedef struct {
+    const odhs_system *sys;
+    int dim;
+    size_t n;
+    const double *L, *x, *r;
+    double gamma;
+} body_in;
 
-static int write_body(FILE *f, const odhs_system *sys, int dim, size_t n, const double *L,
-                      double gamma, const double *x, const double *r)
+static int write_body(FILE *f, const void *ctx)
 {
+    const body_in *in = ctx;
+    const odhs_system *sys = in->sys;
+    int dim = in->dim;
+    size_t n = in->n;
+    const double *L = in->L, *x = in->x, *r = in->r;
+    double gamma = in->gamma;
     double Lz = dim == 3 ? L[2] : 1.0;
     if (fprintf(f, "%zu\n", n) < 0) return -1;
     if (fprintf(f,
@@ -65,64 +68,18 @@ int odhs_xyz_write(const odhs_system *sys, const char *path)
 
     double *x = odhs__malloc_array(n, (size_t)dim * sizeof(double));
     double *r = odhs__malloc_array(n, sizeof(double));
-    size_t plen = strlen(path);
-    char *tmp = (plen < ((size_t)-1) - 64) ? odhs__malloc(plen + 64) : NULL;
-    FILE *f = NULL;
-    if (!x || !r || !tmp) {
+    if (!x || !r) {
         st = odhs__syserr(sys, ODHS_E_NOMEM, "out of memory writing '%s'", path);
         goto done;
     }
-    if ((st = odhs_system_get_positions(sys, x)) < 0 || (st = odhs_system_get_radii(sys, r)) < 0)
-        goto done;
-
-    /* unique temporary name in the same directory, then rename() over path */
-    for (int attempt = 0;; attempt++) {
-        unsigned long k = tmp_counter++;
-        snprintf(tmp, plen + 64, "%s.tmp.%ld.%lu", path, (long)getpid(), k);
-        errno = 0;
-        f = fopen(tmp, "wx");
-        if (f || errno != EEXIST || attempt >= 100) break;
-    }
-    if (!f) {
-        int e = errno;
-        st = odhs__syserr(sys, ODHS_E_IO, "cannot write '%s': %s", path,
-                          e ? strerror(e) : "cannot create temporary file");
-        goto done;
-    }
-    errno = 0;
-    int wr = write_body(f, sys, dim, n, L, gamma, x, r);
-    int e = errno;
-    if (wr == 0 && fflush(f) != 0) {
-        wr = -1;
-        e = errno;
-    }
-    if (wr == 0 && ferror(f)) wr = -1;
-    int cl = fclose(f);
-    if (wr == 0 && cl != 0) {
-        wr = -1;
-        e = errno;
-    }
-    f = NULL;
-    if (wr != 0) {
-        remove(tmp);
-        st = odhs__syserr(sys, wr == -2 ? ODHS_E_INTERNAL : ODHS_E_IO,
-                          "cannot write '%s': %s", path,
-                          wr == -2 ? "species lookup failed" : e ? strerror(e) : "write error");
-        goto done;
-    }
-    errno = 0;
-    if (rename(tmp, path) != 0) {
-        e = errno;
-        remove(tmp);
-        st = odhs__syserr(sys, ODHS_E_IO, "cannot rename '%s' to '%s': %s", tmp, path,
-                          e ? strerror(e) : "rename failed");
-        goto done;
-    }
-    st = ODHS_OK;
+    if ((st = odhs_system_get_positions(sys, x)) < 0 || (st = odhs_system_get_radii(sys, r)) < 0) goto done;
+    body_in in = {sys, dim, n, L, x, r, gamma};
+    char msg[ODHS_ERRMSG_LEN];
+    st = odhs__write_atomic(path, write_body, &in, msg);
+    if (st < 0) odhs__syserr(sys, st, "%s", msg);
 
 done:
     odhs__free(x);
     odhs__free(r);
-    odhs__free(tmp);
     return st;
 }

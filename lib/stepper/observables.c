@@ -142,6 +142,16 @@ int odhs_stepper_nonaffine_velocities(const odhs_stepper *st, double *U)
     return ODHS_OK;
 }
 
+int odhs_stepper_external_forces(const odhs_stepper *st, double *F)
+{
+    NEED(st, F);
+    int s = need_ready(st);
+    if (s) return s;
+    if (st->has_F) memcpy(F, st->F, st->nd * sizeof *F);
+    else memset(F, 0, st->nd * sizeof *F);
+    return ODHS_OK;
+}
+
 int odhs_stepper_coordination(const odhs_stepper *st, double *z)
 {
     NEED(st, z);

@@ -26,51 +26,9 @@
 
 #include "odhs.h"
 
-/* ---- a private directory for this process under $TMPDIR (or /tmp), removed
- * at a normal exit; the file in it is removed after every input ----------- */
-static char fz_dir[320];
-static char fz_path[400];
-
-static void fz_cleanup(void)
-{
-    if (!fz_dir[0]) return;
-    remove(fz_path);
-    rmdir(fz_dir);
-}
-
-static const char *fz_file(void)
-{
-    if (!fz_dir[0]) {
-        const char *base = getenv("TMPDIR");
-        if (!base || !*base || strlen(base) > 256) base = "/tmp";
-        snprintf(fz_dir, sizeof fz_dir, "%s/odhs-fuzz-xyz-XXXXXX", base);
-        if (!mkdtemp(fz_dir)) {
-            perror("fuzz_xyz: mkdtemp");
-            abort();
-        }
-        snprintf(fz_path, sizeof fz_path, "%s/roundtrip.xyz", fz_dir);
-        atexit(fz_cleanup);
-    }
-    return fz_path;
-}
-
-#define FZ_CHECK(cond, ...)                                                    \
-    do {                                                                       \
-        if (!(cond)) {                                                         \
-            fprintf(stderr, "fuzz_xyz: check failed: %s\n  ", #cond);         \
-            fprintf(stderr, __VA_ARGS__);                                      \
-            fputc('\n', stderr);                                               \
-            abort();                                                           \
-        }                                                                      \
-    } while (0)
-
-/* bit-exact comparison of two arrays of doubles; -1 if equal, else the index */
-static long first_diff(const double *a, const double *b, size_t n)
-{
-    for (size_t k = 0; k < n; ++k)
-        if (memcmp(&a[k], &b[k], sizeof(double)) != 0) return (long)k;
-    return -1;
-}
+#define FZ_NAME "fuzz_xyz"
+#define FZ_FILE "roundtrip.xyz"
+#include "fuzz_util.h"
 
 static void compare_systems(const odhs_system *a, const odhs_system *b)
 {

@@ -1,7 +1,8 @@
-/* bench/plot.h - a small header-only SVG line/scatter plotter shared by the
- * benchmarks: one panel, linear or logarithmic axes with ticks and grid,
- * series with markers and/or lines, a legend to the right, an optional
- * footnote (machine, settings). Not installed; not part of the library.
+/* examples/plot.h - a small header-only SVG line/scatter plotter shared by the
+ * examples (--plot) and the benchmarks: panels with linear or logarithmic
+ * axes, ticks and grid, series with markers and/or lines, a legend to the
+ * right, an optional footnote (machine, settings); several panels stack in
+ * one picture (pl_write_svg_panels). Not installed; not part of the library.
  *
  *   pl_plot p;
  *   pl_init(&p, "title", "x label", "y label", 1, 1);       // log x, log y
@@ -14,8 +15,8 @@
  * Points that are not finite, or not positive on a log axis, are dropped.
  * Lines join a series' points in the order given (lines = 1).
  */
-#ifndef ODHS_BENCH_PLOT_H
-#define ODHS_BENCH_PLOT_H
+#ifndef ODHS_EXAMPLES_PLOT_H
+#define ODHS_EXAMPLES_PLOT_H
 
 #include <math.h>
 #include <stdio.h>
@@ -192,21 +193,19 @@ static inline void pl_marker(FILE *f, int m, double x, double y, const char *c)
     }
 }
 
-static inline int pl_write_svg(const pl_plot *p, const char *path)
+#define PL_W 860.0 /* size of one panel */
+#define PL_H 520.0
+
+/* one panel at the top left of f's current user space */
+static inline void pl_panel_(const pl_plot *p, FILE *f)
 {
-    FILE *f = fopen(path, "w");
-    if (!f) return -1;
-    const double W = 860, H = 520, L = 80, R = 250, T = 40, B = 70 + 14 * p->nnotes;
+    const double W = PL_W, H = PL_H, L = 80, R = 250, T = 40, B = 70 + 14 * p->nnotes;
     const double pw = W - L - R, ph = H - T - B;
     double x0, x1, y0, y1;
     pl_range(p, 0, &x0, &x1);
     pl_range(p, 1, &y0, &y1);
 #define PL_X(v) (L + ((p->logx ? log10(v) : (v)) - x0) / (x1 - x0) * pw)
 #define PL_Y(v) (T + ph - ((p->logy ? log10(v) : (v)) - y0) / (y1 - y0) * ph)
-    fprintf(f, "<?xml version='1.0' encoding='UTF-8'?>\n");
-    fprintf(f, "<svg xmlns='http://www.w3.org/2000/svg' width='%.0f' height='%.0f' viewBox='0 0 %.0f %.0f' "
-               "font-family='DejaVu Sans, Arial, sans-serif' font-size='12'>\n", W, H, W, H);
-    fprintf(f, "<rect width='100%%' height='100%%' fill='white'/>\n");
     fprintf(f, "<text x='%.1f' y='22' font-size='15' text-anchor='middle'>", L + pw / 2);
     pl_esc(f, p->title);
     fprintf(f, "</text>\n");
@@ -308,11 +307,30 @@ static inline int pl_write_svg(const pl_plot *p, const char *path)
         pl_esc(f, p->note[k]);
         fprintf(f, "</text>\n");
     }
-    fprintf(f, "</svg>\n");
 #undef PL_X
 #undef PL_Y
+}
+
+/* n panels stacked from top to bottom in one SVG picture; 0, or -1 when the
+ * file cannot be written */
+static inline int pl_write_svg_panels(const pl_plot *const *p, int n, const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return -1;
+    fprintf(f, "<?xml version='1.0' encoding='UTF-8'?>\n");
+    fprintf(f, "<svg xmlns='http://www.w3.org/2000/svg' width='%.0f' height='%.0f' viewBox='0 0 %.0f %.0f' "
+               "font-family='DejaVu Sans, Arial, sans-serif' font-size='12'>\n", PL_W, PL_H * n, PL_W, PL_H * n);
+    fprintf(f, "<rect width='100%%' height='100%%' fill='white'/>\n");
+    for (int k = 0; k < n; ++k) {
+        fprintf(f, "<g transform='translate(0,%.0f)'>\n", PL_H * k);
+        pl_panel_(p[k], f);
+        fprintf(f, "</g>\n");
+    }
+    fprintf(f, "</svg>\n");
     return fclose(f) == 0 ? 0 : -1;
 }
+
+static inline int pl_write_svg(const pl_plot *p, const char *path) { return pl_write_svg_panels(&p, 1, path); }
 
 /* least-squares fit of log y = a + e log x over a series' points; returns e */
 static inline double pl_fit_loglog(const double *x, const double *y, size_t n, double *a)
