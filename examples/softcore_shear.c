@@ -31,7 +31,7 @@
         }                                                                                       \
     } while (0)
 
-static int build_scene(int dim, unsigned long n, double phi, unsigned long seed, odhs_system **out)
+static int build_scene(int dim, unsigned long n, double phi, unsigned long seed, int quiet, odhs_system **out)
 {
     odhs_system *sys = NULL;
     double phi0 = dim == 2 ? 0.45 : 0.3;
@@ -49,7 +49,7 @@ static int build_scene(int dim, unsigned long n, double phi, unsigned long seed,
         CHECK(odhs_driver_create(&drv));
         CHECK(odhs_driver_set_compression_rate(drv, 1.0));
         CHECK(odhs_stepper_create(sys, drv, solver, &st));
-        fprintf(stderr, "softcore_shear: compressing from phi = %.3f to %.3f\n", phi0, phi);
+        if (!quiet) fprintf(stderr, "softcore_shear: compressing from phi = %.3f to %.3f\n", phi0, phi);
         rc = odhs_stepper_run_until_packing_fraction(st, phi);
         if (rc) {
             fprintf(stderr, "softcore_shear: compression stopped: %s (%s)\n", odhs_strerror(rc),
@@ -92,7 +92,7 @@ int main(int argc, char **argv)
     double rate = 1e-5, dgamma = 1e-4, strain = 0.02, every = 0.002, alpha = 2.0, kd = 1.0, k0 = 1e-3;
     double mass = 1.0, dt = 0.1, tol = -1.0, phi = 0.80;
     unsigned long n = 256, seed = 1;
-    int mi = 0, integrator = ODHS_SOFTCORE_FIXED, dim = 2;
+    int mi = 0, integrator = ODHS_SOFTCORE_FIXED, dim = 2, quiet = 0;
     const cli_opt opts[] = {
         CLI_OPT_LIST("--model", &mi, "NAME",
                      "rd0, cd0 (overdamped), qs-sd, qs-fire, qs-cg (quasistatic: strain step + steepest descent / "
@@ -118,6 +118,7 @@ int main(int argc, char **argv)
                        CLI_POSITIVE, .deftext = ""),
         CLI_PHI(&phi),
         CLI_SCENE(&n, &dim, &seed),
+        CLI_QUIET(&quiet),
         CLI_END,
     };
     const cli_spec cli = {
@@ -133,7 +134,7 @@ int main(int argc, char **argv)
     int qs = models[mi].qs;
 
     odhs_system *sys = NULL;
-    if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, &sys)) return 1;
+    if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, quiet, &sys)) return 1;
     n = odhs_system_count(sys);
     double phi_now, r_min = INFINITY;
     CHECK(odhs_system_packing_fraction(sys, &phi_now));
@@ -168,8 +169,9 @@ int main(int argc, char **argv)
         }
         CHECK(odhs_softcore_set_shear_rate(sc, rate / tau_e));
     }
-    fprintf(stderr, "softcore_shear: N = %lu, d = %d, phi = %.6f, model %s, %s %g\n", n, odhs_system_dim(sys),
-            phi_now, model_names[mi], qs ? "dgamma" : "gammadot tau_e", qs ? dgamma : rate);
+    if (!quiet)
+        fprintf(stderr, "softcore_shear: N = %lu, d = %d, phi = %.6f, model %s, %s %g\n", n, odhs_system_dim(sys),
+                phi_now, model_names[mi], qs ? "dgamma" : "gammadot tau_e", qs ? dgamma : rate);
 
     FILE *csv;
     if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
@@ -213,17 +215,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "softcore_shear: error writing %s\n", series);
         return 1;
     }
-    if (outpath) {
-        int wr = odhs_xyz_write(sys, outpath);
-        if (wr) {
-            fprintf(stderr, "softcore_shear: cannot write %s: %s\n", outpath, odhs_system_errmsg(sys));
-            return 1;
-        }
-    }
+    if (outpath && cli_write_config(cli.prog, sys, outpath)) return 1;
     uint64_t steps, fe, mit;
     odhs_softcore_counts(sc, &steps, &fe, &mit);
-    fprintf(stderr, "softcore_shear: %llu steps, %llu force evaluations, %llu minimiser iterations\n",
-            (unsigned long long)steps, (unsigned long long)fe, (unsigned long long)mit);
+    if (!quiet)
+        fprintf(stderr, "softcore_shear: %llu steps, %llu force evaluations, %llu minimiser iterations\n",
+                (unsigned long long)steps, (unsigned long long)fe, (unsigned long long)mit);
     odhs_softcore_destroy(sc);
     odhs_system_destroy(sys);
     return rc < 0 ? 1 : 0;

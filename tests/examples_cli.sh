@@ -277,6 +277,10 @@ for prog in compress composite hopper self_propulsion; do
     expect_in out "^  --traj FILE" "$prog --help lists --traj"
     expect_in out "^  --quiet" "$prog --help lists --quiet"
 done
+expect 0 "softcore_shear --quiet" -- "$bin/softcore_shear" --n 32 --phi 0.6 --strain 0.002 --every 0.001 --quiet \
+    --out "$tmp/sc.data"
+[ -s "$tmp/err" ] && { echo "FAIL: softcore_shear --quiet writes to stderr"; fail=$((fail + 1)); } || pass=$((pass + 1))
+expect_in sc.data "^Atoms # sphere" "softcore_shear --out writes a LAMMPS data file"
 expect 0 "minimal --help" -- "$bin/minimal" --help
 expect_in out "^usage: " "minimal --help prints usage"
 expect 2 "minimal bad option" -- "$bin/minimal" --n 5
