@@ -183,7 +183,7 @@ expect 2 "jam_packing missing value" -- "$bin/jam_packing" --seed
 expect_in err "^jam_packing: unknown option or missing value: --seed$" "jam_packing names the option without a value"
 expect 2 "softcore_shear bad integrator" -- "$bin/softcore_shear" --integrator heun
 expect 2 "sweep_serial unknown solver usage" -- "$bin/sweep_serial" --solver nonsense
-expect_in err "(default auto)" "sweep_serial usage after a bad solver shows the default"
+expect_in err "(default cholmod when$" "sweep_serial usage after a bad solver shows the default"
 # ---- what users look at (issue 20): library defaults, trajectories, files
 # for other tools, plots, progress lines
 py=$(command -v /usr/bin/python3 || command -v python3)

@@ -1006,7 +1006,7 @@ static int write_summary(const settings *S)
 
 int main(int argc, char **argv)
 {
-    settings S = {.campaign = NULL, .out = "sweep_out", .solver = CLI_DEFAULT_SOLVER, .every = 0.01, .transient = 0.2,
+    settings S = {.campaign = NULL, .out = "sweep_out", .solver = NULL, .every = 0.01, .transient = 0.2,
                   .checkpoint = 0.1, .dt = 1e-3, .quiet = 0, .runs = NULL, .nruns = 0, .rank = 0, .size = 1};
 #ifndef SWEEP_NO_MPI
     MPI_Init(&argc, &argv);
@@ -1028,7 +1028,12 @@ int main(int argc, char **argv)
         CLI_OPT_DOUBLE("--checkpoint", &S.checkpoint, "X", "strain between checkpoints, rounded to a multiple of --every",
                        CLI_POSITIVE),
         CLI_DT(&S.dt, "strain units"),
-        CLI_SOLVER(&S.solver),
+        /* not auto: a run resumed from a checkpoint must equal an unbroken one
+         * bit for bit, and only stateless solvers continue so (auto and
+         * cholmod-pcg keep state that the checkpoint does not hold) */
+        CLI_OPT_STRING("--solver", &S.solver, "NAME", CLI_SOLVER_HELP,
+                       .deftext = "cholmod when built in, else cg: resumed runs are bit-identical only with a "
+                                  "stateless solver"),
         CLI_OPT_FLAG("--quiet", &S.quiet, "no per-run progress lines"),
         CLI_END,
     };
@@ -1043,7 +1048,11 @@ int main(int argc, char **argv)
     /* status: 0 go on, -1 after --help (exit 0), else the exit status */
     int status = cli_parse(&cli, argc, argv);
     status = status == CLI_GO ? 0 : status == 0 ? -1 : status;
-    if (status == 0) {
+    if (!S.solver) {
+        odhs_solver *s;
+        S.solver = odhs_solver_create_by_name("cholmod", &s) == ODHS_OK ? "cholmod" : "cg";
+        if (!strcmp(S.solver, "cholmod")) odhs_solver_destroy(s);
+    } else if (status == 0) {
         odhs_solver *s;
         int rc = odhs_solver_create_by_name(S.solver, &s);
         if (rc) {
