@@ -43,6 +43,8 @@
 
 #include <odhs.h>
 
+#include "plot.h"
+
 /* a finite double taking the whole string; 0 on success */
 static inline int cli_double(const char *s, double *out)
 {
@@ -612,6 +614,58 @@ static inline int cli_traj_close(cli_traj *t)
     }
     t->tr = t->contacts = NULL;
     return bad;
+}
+
+/* ---- --plot: a series against its first column --------------------------------- */
+
+#define CLI_PLOT(p)                                                                                                  \
+    CLI_OPT_STRING("--plot", p, "FILE.svg", "plot the series: each column against the first, one panel each",     \
+                   CLI_ANY)
+#define CLI_PLOT_MAX 8 /* panels */
+
+typedef struct {
+    pl_plot panel[CLI_PLOT_MAX];
+    int n, on;
+} cli_plot;
+
+/* panels for the CSV header columns (the first is the x axis); nothing
+ * without a path */
+static inline void cli_plot_init(cli_plot *p, const char *path, const char *title, const char *columns)
+{
+    memset(p, 0, sizeof *p);
+    if (!path) return;
+    p->on = 1;
+    char names[CLI_PLOT_MAX + 1][48];
+    int k = 0;
+    for (const char *c = columns; *c && k <= CLI_PLOT_MAX; ++k) {
+        size_t w = strcspn(c, ",");
+        snprintf(names[k], sizeof names[k], "%.*s", (int)(w < 47 ? w : 47), c);
+        c += w + (c[w] == ',');
+    }
+    for (int j = 1; j < k; ++j) {
+        pl_init(&p->panel[p->n], j == 1 ? title : "", names[0], names[j], 0, 0);
+        pl_series_add(&p->panel[p->n], names[j], j - 1, 0, 0);
+        p->n++;
+    }
+}
+
+/* one row: v[0] the x value, v[1..] the columns */
+static inline void cli_plot_row(cli_plot *p, const double *v)
+{
+    for (int j = 0; p->on && j < p->n; ++j) pl_point(&p->panel[j], 0, v[0], v[j + 1]);
+}
+
+/* write the picture and free the panels; 0, or 1 with a message */
+static inline int cli_plot_write(cli_plot *p, const char *prog, const char *path)
+{
+    if (!p->on) return 0;
+    const pl_plot *panels[CLI_PLOT_MAX];
+    for (int j = 0; j < p->n; ++j) panels[j] = &p->panel[j];
+    int bad = pl_write_svg_panels(panels, p->n, path);
+    for (int j = 0; j < p->n; ++j) pl_free(&p->panel[j]);
+    p->on = 0;
+    if (bad) fprintf(stderr, "%s: cannot write %s\n", prog, path);
+    return bad != 0;
 }
 
 #endif /* ODHS_EXAMPLES_CLI_H */

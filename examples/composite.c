@@ -87,7 +87,7 @@ static int build(unsigned long nb, int k, unsigned long seed, odhs_system **out)
 
 int main(int argc, char **argv)
 {
-    const char *series = NULL, *svg = NULL, *outpath = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *series = NULL, *plot = NULL, *svg = NULL, *outpath = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
     double phi = 0.70, strain = 1.0, every = 0.05, tol = 1e-6, traj_every = 0.0;
     unsigned long nb = 100, k = 3, seed = 1;
@@ -103,6 +103,7 @@ int main(int argc, char **argv)
         CLI_TOL(&tol),
         CLI_SOLVER(&solver_name),
         CLI_SERIES(&series, SERIES),
+        CLI_PLOT(&plot),
         CLI_SVG(&svg),
         CLI_OUT(&outpath),
         CLI_TRAJ(&traj),
@@ -174,6 +175,8 @@ int main(int argc, char **argv)
     if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     cli_progress prog;
     cli_traj tr;
+    cli_plot pl;
+    cli_plot_init(&pl, plot, "composite particles under shear", SERIES);
     cli_progress_init(&prog, cli.prog, quiet);
     if (cli_traj_open(&tr, cli.prog, traj, traj_contacts, traj_every)) return 1;
     printf("%10s %14s %14s %8s %10s %11s\n", "strain", "shear_stress", "pressure", "z", "events", "bond_error");
@@ -200,6 +203,7 @@ int main(int argc, char **argv)
         printf("%10.4f %14.6e %14.6e %8.4f %10llu %11.2e\n", g - g0, s, p, z, (unsigned long long)(nc + no), gap);
         if (csv)
             fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu,%.3e\n", g - g0, s, p, z, (unsigned long long)(nc + no), gap);
+        cli_plot_row(&pl, (double[]){g - g0, s, p, z, (double)(nc + no), gap});
         if (cli_traj_output(&tr, sys, st, g - g0)) return 1;
         cli_progress_show(&prog, g - g0, strain, q == nout, "strain %.3f / %.3f, %llu steps, %llu events", g - g0,
                           strain, (unsigned long long)steps, (unsigned long long)(nc + no));
@@ -208,6 +212,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "composite: error writing %s\n", series);
         return 1;
     }
+    if (cli_plot_write(&pl, cli.prog, plot)) return 1;
     if (svg && odhs_svg_write(sys, odhs_stepper_network(st), NULL, svg)) {
         fprintf(stderr, "composite: cannot write %s: %s\n", svg, odhs_system_errmsg(sys));
         return 1;

@@ -17,7 +17,7 @@
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *in = NULL, *outpath = NULL, *series = NULL, *plot = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
     double phi_target = 0.80, every = 0.01, dt = 1e-3, tol = 1e-6, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
@@ -28,6 +28,7 @@ int main(int argc, char **argv)
         CLI_OPT_FLAG("--jam", &jam, "compress until the network is potentially jammed instead"),
         CLI_OUT(&outpath),
         CLI_SERIES(&series, SERIES),
+        CLI_PLOT(&plot),
         CLI_EVERY(&every, "packing fraction"),
         CLI_TRAJ(&traj),
         CLI_TRAJ_EVERY(&traj_every, "packing fraction"),
@@ -72,6 +73,8 @@ int main(int argc, char **argv)
     if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     cli_progress prog;
     cli_traj tr;
+    cli_plot pl;
+    cli_plot_init(&pl, plot, "compression at rate 1", SERIES);
     cli_progress_init(&prog, cli.prog, quiet);
     if (cli_traj_open(&tr, cli.prog, traj, traj_contacts, traj_every)) return 1;
     /* the first frame, at the start: the state the first step would make
@@ -92,6 +95,7 @@ int main(int argc, char **argv)
         odhs_stepper_counts(st, NULL, &nc, &no);
         printf("%10.6f %14.6e %8.4f %10llu\n", phi, p, z, (unsigned long long)(nc + no));
         if (csv) fprintf(csv, "%.12g,%.10g,%.6f,%llu\n", phi, p, z, (unsigned long long)(nc + no));
+        cli_plot_row(&pl, (double[]){phi, p, z, (double)(nc + no)});
         if (cli_traj_output(&tr, sys, st, phi)) {
             status = 1;
             break;
@@ -123,7 +127,7 @@ int main(int argc, char **argv)
         if (rc < 0) fprintf(stderr, "compress: final correction: %s\n", odhs_stepper_errmsg(st));
     }
     if (csv) fclose(csv);
-    if (cli_traj_close(&tr)) status = 1;
+    if (cli_traj_close(&tr) || cli_plot_write(&pl, cli.prog, plot)) status = 1;
     if (outpath && cli_write_config(cli.prog, sys, outpath)) status = 1;
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);

@@ -111,7 +111,7 @@ out:
 
 int main(int argc, char **argv)
 {
-    const char *series = NULL, *svg = NULL, *outpath = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *series = NULL, *plot = NULL, *svg = NULL, *outpath = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
     double outlet = 3.2, width = 24.0, tmax = 400.0, every = 1.0, tol = 1e-6, traj_every = 0.0;
     unsigned long n = 300, seed = 1;
@@ -127,6 +127,7 @@ int main(int argc, char **argv)
         CLI_TOL(&tol),
         CLI_SOLVER(&solver_name),
         CLI_SERIES(&series, SERIES),
+        CLI_PLOT(&plot),
         CLI_SVG(&svg),
         CLI_OUT(&outpath),
         CLI_TRAJ(&traj),
@@ -223,6 +224,8 @@ int main(int argc, char **argv)
     double t = 0.0, t_last = -1.0, t_clog = -1.0, vfree = 2.0; /* speed of a free large disc */
     cli_progress prog;
     cli_traj tr;
+    cli_plot pl;
+    cli_plot_init(&pl, plot, "discharge of a hopper", SERIES);
     cli_progress_init(&prog, cli.prog, quiet);
     if (cli_traj_open(&tr, cli.prog, traj, traj_contacts, traj_every)) return 1;
     /* the first frame, at the start: the state the first step would make
@@ -259,6 +262,7 @@ int main(int argc, char **argv)
         printf("%10.2f %11lu %12.4e %8.4f %10llu\n", t / tau, discharged, vmean, z, (unsigned long long)(nc + no));
         if (csv)
             fprintf(csv, "%.6g,%lu,%.6e,%.6f,%llu\n", t / tau, discharged, vmean, z, (unsigned long long)(nc + no));
+        cli_plot_row(&pl, (double[]){t / tau, (double)discharged, vmean, z, (double)(nc + no)});
         if (cli_traj_output(&tr, sys, st, t / tau)) return 1;
         int clogged = vmax < 1e-9 * vfree; /* everything at rest: the outlet is clogged */
         cli_progress_show(&prog, t / tau, tmax, q == nout || clogged, "t = %.1f tau, %lu discharged, mean speed %.3g",
@@ -282,6 +286,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "hopper: error writing %s\n", series);
         return 1;
     }
+    if (cli_plot_write(&pl, cli.prog, plot)) return 1;
     if (svg && odhs_svg_write(sys, odhs_stepper_network(st), mark, svg)) {
         fprintf(stderr, "hopper: cannot write %s: %s\n", svg, odhs_system_errmsg(sys));
         return 1;

@@ -117,7 +117,7 @@ static int add_arrows(const char *path, const odhs_system *sys, const double *F,
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *in = NULL, *outpath = NULL, *series = NULL, *plot = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
     double T = 20.0, tmax = 10.0, every = 1.0, dt = 1e-2, phi = 0.5, tol = 1e-6, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
@@ -128,6 +128,7 @@ int main(int argc, char **argv)
         CLI_OPT_DOUBLE("--tmax", &tmax, "X", "persistence times uniform in [0, X] tau", CLI_POSITIVE),
         CLI_EVERY(&every, "tau"),
         CLI_SERIES(&series, SERIES),
+        CLI_PLOT(&plot),
         CLI_SVG(&svg),
         CLI_OUT(&outpath),
         CLI_TRAJ(&traj),
@@ -203,6 +204,8 @@ int main(int argc, char **argv)
     if (cli_series(cli.prog, series, SERIES, &csv)) return 1;
     cli_progress prog;
     cli_traj tr;
+    cli_plot pl;
+    cli_plot_init(&pl, plot, "self-propelled discs", SERIES);
     cli_progress_init(&prog, cli.prog, quiet);
     if (cli_traj_open(&tr, cli.prog, traj, traj_contacts, traj_every)) return 1;
     printf("%10s %12s %14s %8s %10s %10s\n", "time", "mean_speed", "pressure", "z", "collisions", "openings");
@@ -239,6 +242,7 @@ int main(int argc, char **argv)
         if (csv)
             fprintf(csv, "%.10g,%.10g,%.10g,%.6f,%llu,%llu\n", t / tau, speed, p, z, (unsigned long long)nc,
                     (unsigned long long)no);
+        cli_plot_row(&pl, (double[]){t / tau, speed, p, z, (double)nc, (double)no});
         if (cli_traj_output(&tr, sys, st, t / tau)) return 1;
         cli_progress_show(&prog, t / tau, T, k == nout, "t = %.2f / %.2f tau, %llu steps, %llu events", t / tau, T,
                           (unsigned long long)steps, (unsigned long long)(nc + no));
@@ -256,6 +260,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "self_propulsion: error writing %s\n", series);
         return 1;
     }
+    if (cli_plot_write(&pl, cli.prog, plot)) return 1;
     if (svg) {
         double *F = malloc(n * d * sizeof *F);
         int w = odhs_svg_write(sys, odhs_stepper_network(st), NULL, svg);

@@ -25,7 +25,6 @@
 #include <odhs.h>
 
 #include "cli.h"
-#include "plot.h"
 
 /* the --series columns (columns are only ever added, at the end) */
 #define SERIES "strain,shear_stress,pressure,z,events,phi,kappa,time,collisions,openings,dissipation"

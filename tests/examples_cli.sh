@@ -261,7 +261,10 @@ for prog in compress composite hopper self_propulsion; do
     [ -s "$tmp/err" ] && { echo "FAIL: $prog --quiet writes to stderr"; fail=$((fail + 1)); } || pass=$((pass + 1))
     # shellcheck disable=SC2086
     expect 0 "$prog with --traj" -- "$bin/$prog" ${args[$prog]} --out "$tmp/$prog.b.xyz" --traj "$tmp/$prog.t.xyz" \
-        --traj-contacts "$tmp/$prog.t.bonds"
+        --traj-contacts "$tmp/$prog.t.bonds" --series "$tmp/$prog.csv" --plot "$tmp/$prog.svg"
+    # --plot: one panel per series column after the first, with a point per row
+    check_py "$prog --plot" svg "$tmp/$prog.svg" "$(rows "$prog.csv")" \
+        "$(($(head -1 "$tmp/$prog.csv" | tr ',' '\n' | wc -l) - 1))"
     cmp -s "$tmp/$prog.a.xyz" "$tmp/$prog.b.xyz" && pass=$((pass + 1)) \
         || { echo "FAIL: $prog --traj changed the run"; fail=$((fail + 1)); }
     [ "$(grep -c Lattice "$tmp/$prog.t.xyz")" -ge 2 ] && [ "$(grep -c '^ITEM: TIMESTEP' "$tmp/$prog.t.bonds")" -ge 2 ] \
