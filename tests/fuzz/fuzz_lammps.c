@@ -41,54 +41,6 @@
 #define FZ_FILE "roundtrip.data"
 #include "fuzz_util.h"
 
-static void compare_systems(const odhs_system *a, const odhs_system *b)
-{
-    int dim = odhs_system_dim(a);
-    size_t n = odhs_system_count(a);
-    FZ_CHECK(odhs_system_dim(b) == dim, "dim %d != %d", odhs_system_dim(b), dim);
-    FZ_CHECK(odhs_system_count(b) == n, "N %zu != %zu", odhs_system_count(b), n);
-    FZ_CHECK(odhs_system_is_ready(a) && odhs_system_is_ready(b), "systems not ready");
-
-    double La[3] = {0, 0, 0}, Lb[3] = {0, 0, 0}, ga = 0.0, gb = 0.0;
-    FZ_CHECK(odhs_system_get_box(a, La) == ODHS_OK && odhs_system_get_box(b, Lb) == ODHS_OK, "get_box");
-    long k = first_diff(La, Lb, (size_t)dim);
-    FZ_CHECK(k < 0, "box edge %ld: %.17g != %.17g", k, k >= 0 ? La[k] : 0.0, k >= 0 ? Lb[k] : 0.0);
-    FZ_CHECK(odhs_system_get_strain(a, &ga) == ODHS_OK && odhs_system_get_strain(b, &gb) == ODHS_OK,
-             "get_strain");
-    FZ_CHECK(memcmp(&ga, &gb, sizeof ga) == 0, "strain %.17g != %.17g (%a vs %a)", ga, gb, ga, gb);
-
-    double *ra = malloc(n * sizeof *ra), *rb = malloc(n * sizeof *rb);
-    double *xa = malloc(n * (size_t)dim * sizeof *xa), *xb = malloc(n * (size_t)dim * sizeof *xb);
-    FZ_CHECK(ra && rb && xa && xb, "out of memory");
-    FZ_CHECK(odhs_system_get_radii(a, ra) == ODHS_OK && odhs_system_get_radii(b, rb) == ODHS_OK, "radii");
-    k = first_diff(ra, rb, n);
-    FZ_CHECK(k < 0, "radius %ld: %.17g != %.17g", k, k >= 0 ? ra[k] : 0.0, k >= 0 ? rb[k] : 0.0);
-    FZ_CHECK(odhs_system_get_positions(a, xa) == ODHS_OK && odhs_system_get_positions(b, xb) == ODHS_OK,
-             "positions");
-    double Lx = La[0];
-    for (size_t i = 0; i < n; ++i) {
-        for (int c = 1; c < dim; ++c) {
-            size_t j = i * (size_t)dim + (size_t)c;
-            FZ_CHECK(memcmp(&xa[j], &xb[j], sizeof(double)) == 0, "particle %zu coordinate %d: %.17g != %.17g", i,
-                     c, xa[j], xb[j]);
-        }
-        double x1 = xa[i * (size_t)dim], x2 = xb[i * (size_t)dim];
-        double d = x2 - x1;
-        d -= nearbyint(d / Lx) * Lx;
-        FZ_CHECK(fabs(d) <= 2.0 * DBL_EPSILON * Lx, "particle %zu: x %.17g != %.17g modulo Lx = %.17g (%a vs %a)", i,
-                 x1, x2, Lx, x1, x2);
-        char sa[ODHS_SPECIES_MAX + 1], sb[ODHS_SPECIES_MAX + 1];
-        FZ_CHECK(odhs_system_get_species(a, i, sa, sizeof sa) == ODHS_OK &&
-                     odhs_system_get_species(b, i, sb, sizeof sb) == ODHS_OK,
-                 "species of %zu", i);
-        FZ_CHECK(strcmp(sa, sb) == 0, "species of %zu: '%s' != '%s'", i, sa, sb);
-    }
-    free(ra);
-    free(rb);
-    free(xa);
-    free(xb);
-}
-
 /* Whether some pair of sys overlaps by nearly the accepted 1e-4 of its contact
  * distance, within a few ulps of Lx (the most the writer's shift moves x):
  * the read-back may then refuse it. All pairs (fuzz inputs are small);
@@ -146,7 +98,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(back == NULL, "error but a system");
     } else {
         FZ_CHECK(rc == ODHS_OK, "reading back what the library wrote: %d (%s): %s", rc, odhs_strerror(rc), err2);
-        compare_systems(sys, back);
+        fz_compare(sys, back, 1);
     }
     odhs_system_destroy(back);
     odhs_system_destroy(sys);
