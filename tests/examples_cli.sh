@@ -242,7 +242,10 @@ if command -v lmp > /dev/null; then
 else
     echo "skipped: lmp (Debian lammps) not installed: LAMMPS reading our data file not checked"
 fi
-expect 1 "shear_flow malformed data file" -- "$bin/shear_flow" --in "$tmp/t.csv.data"
+cp "$tmp/t.csv" "$tmp/bad.data"
+expect 1 "shear_flow malformed data file" -- "$bin/shear_flow" --in "$tmp/bad.data"
+expect_in err "line" "shear_flow names the bad line of a data file"
+expect 1 "shear_flow missing data file" -- "$bin/shear_flow" --in "$tmp/missing.data"
 expect 0 "jam_packing --traj" -- "$bin/jam_packing" --n 32 --traj "$tmp/j.xyz" --traj-every 0.05 --out "$tmp/j1.xyz" \
     --quiet
 expect 0 "jam_packing without --traj" -- "$bin/jam_packing" --n 32 --out "$tmp/j2.xyz" --quiet
