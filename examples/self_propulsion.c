@@ -117,7 +117,8 @@ static int add_arrows(const char *path, const odhs_system *sys, const double *F,
 
 int main(int argc, char **argv)
 {
-    const char *in = NULL, *outpath = NULL, *series = NULL, *plot = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
+    const char *in = NULL, *outpath = NULL, *series = NULL, *plot = NULL;
+    const char *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
     double T = 20.0, tmax = 10.0, every = 1.0, dt = 1e-2, phi = 0.5, tol = 1e-6, traj_every = 0.0;
     unsigned long n = 256, seed = 1;

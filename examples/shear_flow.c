@@ -66,11 +66,11 @@ static int output(outputs *o, odhs_stepper *st, odhs_system *sys, double x, doub
     else if (o->fixed_p) printf("%12.6f %14.6e %14.6e %8.4f %10llu %10.6f %14.6e\n", g, s, p, z, ev, phi, kappa);
     else printf("%12.6f %14.6e %14.6e %8.4f %10llu\n", g, s, p, z, ev);
     if (o->csv && osc)
-        fprintf(o->csv, "%.10g,%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g,%llu,%llu,%.10g\n", t, g, s, p, z, ev, phi, kappa,
-                (unsigned long long)nc, (unsigned long long)no, D);
+        fprintf(o->csv, "%.10g,%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g,%llu,%llu,%.10g\n", t, g, s, p, z, ev, phi,
+                kappa, (unsigned long long)nc, (unsigned long long)no, D);
     else if (o->csv)
-        fprintf(o->csv, "%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g,%.10g,%llu,%llu,%.10g\n", g, s, p, z, ev, phi, kappa, t,
-                (unsigned long long)nc, (unsigned long long)no, D);
+        fprintf(o->csv, "%.10g,%.10g,%.10g,%.6f,%llu,%.10g,%.10g,%.10g,%llu,%llu,%.10g\n", g, s, p, z, ev, phi, kappa,
+                t, (unsigned long long)nc, (unsigned long long)no, D);
     if (o->npanel) {
         pl_point(&o->panel[0], 0, x, s);
         pl_point(&o->panel[0], 1, x, p);
