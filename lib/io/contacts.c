@@ -3,13 +3,18 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "io/text.h"
 #include "network/network.h"
 
-/* one writer's body: 0 on success */
-typedef int (*body_fn)(FILE *f, const odhs_network *net, const odhs_system *sys);
+typedef struct {
+    const odhs_network *net;
+    const odhs_system *sys;
+} body_in;
 
-static int body_text(FILE *f, const odhs_network *net, const odhs_system *sys)
+static int body_text(FILE *f, const void *ctx)
 {
+    const odhs_network *net = ((const body_in *)ctx)->net;
+    const odhs_system *sys = ((const body_in *)ctx)->sys;
     int d = net->dim, ok = 1;
     ok &= fprintf(f, "# libodhs contacts N=%zu dim=%d Nc=%zu\n", net->n, d, net->nc) > 0;
     ok &= fprintf(f, "# i j %s force gap\n", d == 2 ? "s0 s1" : "s0 s1 s2") > 0;
@@ -30,9 +35,9 @@ static int body_text(FILE *f, const odhs_network *net, const odhs_system *sys)
     return ok ? 0 : -1;
 }
 
-static int body_csv(FILE *f, const odhs_network *net, const odhs_system *sys)
+static int body_csv(FILE *f, const void *ctx)
 {
-    (void)sys;
+    const odhs_network *net = ((const body_in *)ctx)->net;
     int ok = fprintf(f, "i,j,kind,force,gap\n") > 0;
     for (size_t c = 0; c < net->nc && ok; ++c)
         ok &= fprintf(f, "%zu,%zu,%d,%.17g,%.17g\n", net->ci[c], net->cj[c], (int)net->kind[c], net->f[c],
@@ -41,34 +46,17 @@ static int body_csv(FILE *f, const odhs_network *net, const odhs_system *sys)
 }
 
 /* the checks, then body into a temporary file renamed to path */
-static int write_file(const odhs_network *net, const odhs_system *sys, const char *path, body_fn body)
+static int write_file(const odhs_network *net, const odhs_system *sys, const char *path, odhs__body_fn body)
 {
     if (!net) return ODHS_E_NULL;
     if (!sys || !path) return odhs__neterr(net, ODHS_E_NULL, "NULL argument");
     if (sys->n != net->n || sys->dim != net->dim)
         return odhs__neterr(net, ODHS_E_DIM, "system and network differ in N or dimension");
     if (!sys->has_x || !sys->has_r) return odhs__neterr(net, ODHS_E_STATE, "system radii and positions unset");
-    size_t len = strlen(path);
-    char *tmp = odhs__malloc(len + 32);
-    if (!tmp) return odhs__neterr(net, ODHS_E_NOMEM, "out of memory");
-    snprintf(tmp, len + 32, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        int e = odhs__neterr(net, ODHS_E_IO, "cannot write %s", tmp);
-        odhs__free(tmp);
-        return e;
-    }
-    int ok = body(f, net, sys) == 0;
-    ok &= fflush(f) == 0;
-    ok &= fclose(f) == 0;
-    if (!ok || rename(tmp, path) != 0) {
-        remove(tmp);
-        int e = odhs__neterr(net, ODHS_E_IO, "error writing %s", path);
-        odhs__free(tmp);
-        return e;
-    }
-    odhs__free(tmp);
-    return ODHS_OK;
+    body_in in = {net, sys};
+    char msg[ODHS_ERRMSG_LEN];
+    int st = odhs__write_atomic(path, body, &in, msg);
+    return st < 0 ? odhs__neterr(net, st, "%s", msg) : ODHS_OK;
 }
 
 int odhs_contacts_write(const odhs_network *net, const odhs_system *sys, const char *path)
