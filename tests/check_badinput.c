@@ -1549,15 +1549,16 @@ static int huge_rate_case(void)
     X(sp_get_off, odhs_driver_get_propulsion, ODHS_E_STATE, NOALT, H_DRV, 0,                                   \
       double F[32] = {0}; F[3] = 7.0; int rc = odhs_driver_get_propulsion(w->drv, F, NULL);                    \
       return F[3] != 7.0 ? post("output written") : rc;)                                                       \
-    X(sp_get_not_started, odhs_driver_get_propulsion, ODHS_E_STATE, NOALT, H_DRV, 0,                           \
+    X(sp_get_not_started, odhs_driver_get_propulsion, ODHS_E_STATE, NOALT, H_NONE, 0,                           \
       /* forces exist at once, switch times only when a stepper starts the clock */                            \
       double F[32], ts[16] = {0}; ts[0] = 7.0;                                                                 \
       int rc = odhs_driver_set_self_propulsion(w->drv, 16, 2, 0.5, 1.0, 0.0, 1.0, 1);                          \
       if (rc) return post("set_self_propulsion %d", rc);                                                       \
       if ((rc = odhs_driver_get_propulsion(w->drv, F, NULL))) return post("forces: %d", rc);                   \
       rc = odhs_driver_get_propulsion(w->drv, F, ts);                                                          \
-      odhs_driver_clear_self_propulsion(w->drv);                                                               \
-      return ts[0] != 7.0 ? post("output written") : rc;)                                                      \
+      int has_msg = odhs_driver_errmsg(w->drv)[0] != '\0';                                                   \
+      odhs_driver_clear_self_propulsion(w->drv); /* clears the message: a successful call */                   \
+      return ts[0] != 7.0 ? post("output written") : !has_msg ? post("no message") : rc;)                     \
     X(sp_next_null, odhs_driver_next_switch, ODHS_E_NULL, NOALT, H_NONE, 0,                                    \
       double t; return odhs_driver_next_switch(NULL, &t);)                                                     \
     X(sp_next_null_out, odhs_driver_next_switch, ODHS_E_NULL, NOALT, H_DRV, 0,                                 \
@@ -2168,6 +2169,52 @@ static int traj_status(odhs_traj *tr, int rc)
     X(sc_reset_ok, odhs_softcore_reset, ODHS_OK, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_reset(sc));) \
     X(sc_counts_ok, odhs_softcore_counts, ODHS_OK, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_counts(sc));)
 
+/* the embedding calls of 0.2.7 (issue 19): messages of failed creates,
+ * solver names, the system's change counter, step info with a size, run
+ * limits, bulk contacts */
+#define EMBED_CASES(X)                                                                                         \
+    X(last_error_create, odhs_last_error, ODHS_OK, NOALT, H_NONE, 0,                                           \
+      odhs_solver *q = NULL; int rc = odhs_solver_create_by_name("bogus", &q);                                 \
+      if (rc != ODHS_E_INVALID || q) return post("create_by_name(bogus) -> %d", rc);                           \
+      if (!strstr(odhs_last_error(), "bogus") || !strstr(odhs_last_error(), "cholmod"))                        \
+          return post("last_error \"%s\" names neither the name nor the valid ones", odhs_last_error());       \
+      if (odhs_solver_create_by_name("cg", &q) != ODHS_OK) return post("cg not created");                      \
+      odhs_solver_destroy(q);                                                                                  \
+      return odhs_last_error()[0] ? post("last_error \"%s\" after a success", odhs_last_error()) : ODHS_OK;)   \
+    X(solver_list_null, odhs_solver_list, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_solver_list(0, NULL, NULL);) \
+    X(solver_list_end, odhs_solver_list, ODHS_E_RANGE, NOALT, H_NONE, 0,                                       \
+      const char *nm = "x"; int rc = odhs_solver_list(1000, &nm, NULL);                                        \
+      return nm ? post("name not NULL past the end") : rc;)                                                    \
+    X(sys_change_count_null, odhs_system_change_count, ODHS_E_NULL, NOALT, H_NONE, 0,                          \
+      uint64_t c; return odhs_system_change_count(NULL, &c);)                                                  \
+    X(sys_change_count_null_out, odhs_system_change_count, ODHS_E_NULL, NOALT, H_SYS2, 0,                      \
+      return odhs_system_change_count(w->sys2, NULL);)                                                         \
+    X(drv_clear_time_unit_null, odhs_driver_clear_time_unit, ODHS_E_NULL, NOALT, H_NONE, 0,                    \
+      return odhs_driver_clear_time_unit(NULL);)                                                               \
+    X(st_step_ex_null, odhs_stepper_step_ex, ODHS_E_NULL, NOALT, H_NONE, 0,                                    \
+      odhs_step_info in = {sizeof in, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};                                  \
+      return odhs_stepper_step_ex(NULL, &in);)                                                                 \
+    X(st_step_ex_null_info, odhs_stepper_step_ex, ODHS_E_NULL, NOALT, H_ST, 0,                                 \
+      return odhs_stepper_step_ex(w->st, NULL);)                                                               \
+    X(st_step_ex_size0, odhs_stepper_step_ex, ODHS_E_INVALID, NOALT, H_RUN, 0,                                 \
+      odhs_step_info in; memset(&in, 0xab, sizeof in); in.size = 0;                                            \
+      int rc = odhs_stepper_step_ex(w->run, &in);                                                              \
+      return in.kind != (int)0xabababab ? post("info written on error") : rc;)                                 \
+    X(st_set_run_limits_null, odhs_stepper_set_run_limits, ODHS_E_NULL, NOALT, H_NONE, 0,                      \
+      return odhs_stepper_set_run_limits(NULL, 0, 0);)                                                         \
+    X(st_get_run_limits_null, odhs_stepper_get_run_limits, ODHS_E_NULL, NOALT, H_NONE, 0,                      \
+      uint64_t a, b; return odhs_stepper_get_run_limits(NULL, &a, &b);)                                        \
+    X(st_contacts_null, odhs_stepper_contacts, ODHS_E_NULL, NOALT, H_NONE, 0,                                  \
+      size_t nc; return odhs_stepper_contacts(NULL, 0, &nc, NULL, NULL, NULL, NULL, NULL);)                    \
+    X(st_contacts_null_nc, odhs_stepper_contacts, ODHS_E_NULL, NOALT, H_RUN, 0,                                \
+      return odhs_stepper_contacts(w->run, 0, NULL, NULL, NULL, NULL, NULL, NULL);)                            \
+    X(st_contacts_not_ready, odhs_stepper_contacts, ODHS_E_STATE, NOALT, H_ST, 0,                              \
+      size_t nc = 7; return odhs_stepper_contacts(w->st, 0, &nc, NULL, NULL, NULL, NULL, NULL);)               \
+    X(net_get_contacts_null, odhs_network_get_contacts, ODHS_E_NULL, NOALT, H_NONE, 0,                         \
+      size_t i[4]; return odhs_network_get_contacts(NULL, i, NULL, NULL);)                                     \
+    X(net_get_contacts_no_out, odhs_network_get_contacts, ODHS_E_NULL, NOALT, H_NET2, 0,                       \
+      return odhs_network_get_contacts(w->net2, NULL, NULL, NULL);)
+
 #define REGRESSION_CASES(X)                                                                             \
     X(reg_wrap_far_positions, odhs_system_set_configuration, ODHS_OK, NOALT, H_NONE, F_NOPROBE,                \
       /* system.h: positions passed in are wrapped into [0,Lx) x [0,Ly); coordinates more than 2^50 box     \
@@ -2243,7 +2290,9 @@ static int sc_noconv(world *w, odhs_softcore *sc)
     odhs_softcore_set_min_tolerance(sc, 1e-300, 1);
     odhs_softcore_set_positions(sc, y);
     int rc = odhs_softcore_minimise(sc, NULL);
-    odhs_softcore_set_positions(sc, x); /* sys2 back bit for bit */
+    /* sys2 back bit for bit, through the system: a successful call on the
+     * softcore handle would clear the message sc_done checks */
+    odhs_system_set_positions(w->sys2, x);
     return rc;
 }
 static int sc_counts(odhs_softcore *sc)
@@ -2288,6 +2337,7 @@ JAMMING_CASES(X_DEFINE)
 CHECKPOINT_CASES(X_DEFINE)
 SOFTCORE_CASES(X_DEFINE)
 OUTPUT_CASES(X_DEFINE)
+EMBED_CASES(X_DEFINE)
 REGRESSION_CASES(X_DEFINE)
 
 static const bad_case common_cases[] = {COMMON_CASES(X_ROW)};
@@ -2301,6 +2351,7 @@ static const bad_case jamming_cases[] = {JAMMING_CASES(X_ROW)};
 static const bad_case checkpoint_cases[] = {CHECKPOINT_CASES(X_ROW)};
 static const bad_case softcore_cases[] = {SOFTCORE_CASES(X_ROW)};
 static const bad_case output_cases[] = {OUTPUT_CASES(X_ROW)};
+static const bad_case embed_cases[] = {EMBED_CASES(X_ROW)};
 static const bad_case regression_cases[] = {REGRESSION_CASES(X_ROW)};
 
 #define NROWS(t) ((int)(sizeof t / sizeof t[0]))
@@ -2314,7 +2365,7 @@ static const struct {
     {solver_cases, NROWS(solver_cases)},   {driver_cases, NROWS(driver_cases)},
     {stepper_cases, NROWS(stepper_cases)}, {jamming_cases, NROWS(jamming_cases)},
     {checkpoint_cases, NROWS(checkpoint_cases)}, {softcore_cases, NROWS(softcore_cases)},
-    {output_cases, NROWS(output_cases)},
+    {output_cases, NROWS(output_cases)},   {embed_cases, NROWS(embed_cases)},
     {regression_cases, NROWS(regression_cases)},
 };
 
@@ -2391,6 +2442,7 @@ TABLE_TEST(test_jamming, jamming_cases)
 TABLE_TEST(test_checkpoint, checkpoint_cases)
 TABLE_TEST(test_softcore, softcore_cases)
 TABLE_TEST(test_output, output_cases)
+TABLE_TEST(test_embed, embed_cases)
 TABLE_TEST(test_regression, regression_cases)
 
 /* ---- coverage: every function declared in the public headers has a row ----- */
@@ -2490,6 +2542,7 @@ Suite *make_badinput_suite(void)
         {"checkpoint", test_checkpoint, NROWS(checkpoint_cases)},
         {"softcore", test_softcore, NROWS(softcore_cases)},
         {"output", test_output, NROWS(output_cases)},
+        {"embed", test_embed, NROWS(embed_cases)},
         {"regression", test_regression, NROWS(regression_cases)},
     };
     for (size_t k = 0; k < sizeof tcs / sizeof tcs[0]; ++k) {

@@ -318,17 +318,23 @@ START_TEST(test_time_unit)
     for (int k = 0; k < 2 * DN; ++k) F[k] *= 2.0;
     ck_assert_int_eq(odhs_driver_set_forces(d, DN, 2, F), ODHS_OK);
     ck_assert_double_eq_tol(drv_tau(d, sys), drv_lambda / (2.5 * 2.0 * frms), 1e-14);
-    /* a user time unit does not override the fixed-force unit */
+    /* a user time unit overrides the fixed-force unit (since 0.2.7: it was
+     * ignored there before, issue 19), and clearing it brings that back */
     ck_assert_int_eq(odhs_driver_set_time_unit(d, 0.7), ODHS_OK);
+    ck_assert_double_eq_tol(drv_tau(d, sys), 0.7, 1e-15);
+    ck_assert_int_eq(odhs_driver_clear_time_unit(d), ODHS_OK);
     ck_assert_double_eq_tol(drv_tau(d, sys), drv_lambda / (2.5 * 2.0 * frms), 1e-14);
+    ck_assert_int_eq(odhs_driver_set_time_unit(d, 0.7), ODHS_OK);
     /* a callback: the user value */
     cb_ctx ctx = {0, 0, 1.0, 0.0};
     ck_assert_int_eq(odhs_driver_set_force_callback(d, drv_cb, &ctx), ODHS_OK);
     ck_assert_double_eq_tol(drv_tau(d, sys), 0.7, 1e-15);
     ck_assert_int_eq(odhs_driver_set_time_unit(d, 3.25), ODHS_OK);
     ck_assert_double_eq_tol(drv_tau(d, sys), 3.25, 1e-15);
-    /* ... unless a flow is set */
+    /* ... and with a flow (since 0.2.7), whose unit comes back when cleared */
     ck_assert_int_eq(odhs_driver_set_shear_rate(d, 0.1), ODHS_OK);
+    ck_assert_double_eq_tol(drv_tau(d, sys), 3.25, 1e-15);
+    ck_assert_int_eq(odhs_driver_clear_time_unit(d), ODHS_OK);
     ck_assert_double_eq_tol(drv_tau(d, sys), 10.0, 1e-14);
     /* a callback without a user time unit: lambda / xi0 */
     odhs_driver *d2 = drv_new();
@@ -402,7 +408,11 @@ START_TEST(test_forces_copy_clear_replace)
     ck_assert_int_eq(ctx.calls, calls);
     ck_assert_int_eq(odhs_stepper_velocities(st, V), ODHS_OK);
     for (int k = 0; k < 2 * DN; ++k) ck_assert_msg(fabs(V[k] - 2.5 * F0[k]) <= 1e-14, "V[%d] = %g", k, V[k]);
+    /* the user's unit set above stays (since 0.2.7); cleared, the forces' */
+    ck_assert_double_eq_tol(drv_tau(d, sys), 0.125, 1e-15);
+    ck_assert_int_eq(odhs_driver_clear_time_unit(d), ODHS_OK);
     ck_assert_double_eq_tol(drv_tau(d, sys), tau, 1e-15);
+    ck_assert_int_eq(odhs_driver_set_time_unit(d, 0.125), ODHS_OK);
 
     /* set_forces(NULL) clears: nothing moves, tau back to the user value
      * set above (it would be lambda / xi0 without one) */

@@ -8,9 +8,19 @@
  * settings and state (time, strain, counters, integrator and adaptive step,
  * the contact network in its order with its forces, velocities, neighbour
  * list and its bookkeeping). Continuing from a checkpoint is bit-identical to
- * the uninterrupted run for the stateless solvers (cg, dense, cholmod, spqr).
+ * the uninterrupted run for the stateless solvers (cg, dense, cholmod, spqr),
+ * whose answer depends only on the network and the right-hand side. It is
+ * not for "cholmod-pcg" and "auto" (primary cholmod-pcg): cholmod-pcg
+ * preconditions with a factor of an older network updated contact by
+ * contact and refactorised on a schedule, a history the checkpoint does not
+ * hold; the restored solver starts from a fresh factor, its iterates differ
+ * at its tolerance (1e-12) and the order of nearly simultaneous events can
+ * change after some steps. Choose "cholmod" for bit-identical restarts.
  * Not saved (they are code, not data): force and event callbacks, and the
- * solver itself: set them again on the restored handles.
+ * solver itself: set them again on the restored handles. That a force
+ * callback was set is saved (section FCB, since 0.2.7): the restored
+ * stepper refuses to step (ODHS_E_STATE) until odhs_driver_set_force_callback
+ * (or odhs_driver_set_forces) is called on the restored driver.
  *
  * Format: little-endian binary; magic "ODHSCKPT", a format version, then
  * tagged sections, then a 64-bit FNV-1a checksum of all preceding bytes.
@@ -23,7 +33,8 @@
  * the forces were solved: the restored stepper re-solves them at its next
  * step, as the original would have), and since 0.2.4 OSC (oscillatory shear:
  * shape, amplitude, period, phase origin), and since 0.2.5 PJAM (a finite
- * jamming pressure, odhs_driver_set_jamming_pressure). A checkpoint that needs none of
+ * jamming pressure, odhs_driver_set_jamming_pressure), and since 0.2.7 FCB (a
+ * force callback was set). A checkpoint that needs none of
  * them is still written as version 1, so older releases read it; this library
  * reads both.
  * Writes go to a temporary file in the same directory that is flushed, synced

@@ -61,6 +61,10 @@ enum {
     ODHS_JAMMED = 3,           /* jammed: the constrained subset is isostatic
                                   and its self-stress f0 is positive; the
                                   run stopped (Sect. IV D)                   */
+    ODHS_STEP_LIMIT = 4,       /* a run call took the number of steps set
+                                  with odhs_stepper_set_run_limits and
+                                  returned before its target (since 0.2.7;
+                                  the state is valid: call again to go on)   */
 
     /* errors (< 0) */
     ODHS_E_NULL = -1,          /* a required pointer argument was NULL       */
@@ -83,11 +87,29 @@ enum {
     ODHS_E_UNSUPPORTED = -18,  /* combination of settings not supported      */
     ODHS_E_TOODENSE = -19,     /* random placement could not reach the
                                   requested packing fraction                 */
-    ODHS_E_INTERNAL = -20      /* internal inconsistency (a bug: report it)  */
+    ODHS_E_INTERNAL = -20,     /* internal inconsistency (a bug: report it)  */
+    ODHS_E_STALLED = -21       /* no progress: a run's target (time, strain,
+                                  packing fraction, events) did not advance
+                                  over the stall limit of steps, or no event
+                                  can ever happen (since 0.2.7)              */
 };
 
 /** Static English description of a status code (never NULL). */
 ODHS_API const char *odhs_strerror(int status);
+
+/**
+ * The message of the last failed call in the calling thread that had no
+ * handle to keep it: the create functions (odhs_system_create,
+ * odhs_system_clone, odhs_driver_create, odhs_network_create,
+ * odhs_solver_create, odhs_solver_create_by_name, odhs_stepper_create,
+ * odhs_softcore_create). Each of them sets it on failure and clears it ("")
+ * on success; other calls leave it alone (they report through their
+ * handle's errmsg, or the readers through their errbuf argument). The text lives in
+ * thread-local storage: separate threads never see each other's messages,
+ * and the pointer stays valid until the thread's next such call. Never NULL.
+ * Since 0.2.7.
+ */
+ODHS_API const char *odhs_last_error(void);
 
 /** Free memory that the library allocated and handed to the caller
  *  (documented per function). NULL is a no-op. */

@@ -19,11 +19,22 @@
  * (eq. 25 with the sign typo of eqs. 21/23 corrected: V_aff = gammadot (R_y x
  * - kappa R), kappa > 0 compresses).
  *
- * Natural time unit tau (the stepper's step size is measured in it, which
- * makes trajectories rate-invariant, Sect. II D): 1/max(|gammadot|, |c|) when
- * a flow is set; otherwise lambda / (xi0 f_rms) for fixed forces, with lambda
- * the mean diameter and f_rms = sqrt(<F|F>/N); otherwise the value set with
- * odhs_driver_set_time_unit (default: lambda / xi0, i.e. unit force).
+ * Time unit tau (the stepper's step size dt is measured in it). The natural
+ * unit, which makes trajectories rate-invariant (Sect. II D):
+ * 1/max(|gammadot|, |c|) when a flow is set; otherwise lambda / (xi0 f_rms)
+ * for fixed forces, with lambda the mean diameter and f_rms = sqrt(<F|F>/N);
+ * otherwise (a force callback, or nothing) lambda / xi0, i.e. unit force.
+ * A unit set with odhs_driver_set_time_unit replaces the natural one in every
+ * scene (since 0.2.7; before, it was used only where no natural unit
+ * existed): set 1 and dt is physical time, the same whatever forces a
+ * framework sets from step to step. The force scale is summed without
+ * overflow; a unit that is not a positive normal double (forces of 1e-310,
+ * or 1e310 with a tiny lambda) is refused with ODHS_E_INVALID. The stepper
+ * squares velocities (collision prediction, error estimates), so it also
+ * refuses (ODHS_E_INVALID; ODHS_E_CALLBACK for a callback's forces) external
+ * forces with xi0 max|F| above 1e150, or nonzero below 1e-150 without a
+ * flow, and flow rates with rate times the box edge outside
+ * [1e-150, 1e150]: change the units instead (since 0.2.7; 0.2.6 stalled).
  * With self-propulsion and/or gravity the force scale is
  *     f_ext^2 = <F_d|F_d>/N + <|F_p|^2>,
  * F_d the deterministic forces (fixed forces plus gravity), <|F_p|^2> =
@@ -147,10 +158,30 @@ ODHS_API int odhs_driver_get_jamming_pressure(const odhs_driver *drv, double *p_
 /** Fixed external forces F[0..n*dim-1] (copied); F == NULL removes them.
  *  Replaces any force callback. */
 ODHS_API int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const double *F);
-/** Force callback (fn == NULL removes it). Replaces any fixed forces. */
+/** Force callback (fn == NULL removes it). Replaces any fixed forces.
+ *  Timing (the callback must be a pure function of t and the positions):
+ *  the stepper asks for the forces whenever it needs them at a new state:
+ *  at odhs_stepper_reset (the current time), at the end of every step (its
+ *  end time and positions), with the Heun integrator also at the
+ *  predictor (the planned end time t0 + h of the step, on positions
+ *  x0 + h V0 that are not on the trajectory), again when a step is repeated
+ *  shorter (a collision or an opening inside it) and after a driver change.
+ *  So a Heun step calls it at least twice, both at end times of the step
+ *  (the forces at its start are those of the previous step's end); it may
+ *  be called more than once at the same t, and t may go back (a rejected or
+ *  repeated step). A callback is code and is not saved in checkpoints: a
+ *  stepper restored from a checkpoint of a run that had one refuses to step
+ *  (ODHS_E_STATE) until this function (or odhs_driver_set_forces) is called
+ *  on its driver. */
 ODHS_API int odhs_driver_set_force_callback(odhs_driver *drv, odhs_force_fn fn, void *ctx);
-/** Natural time unit for callback-driven runs (> 0). */
+/** The time unit tau (> 0, finite) for every scene: it replaces the natural
+ *  unit above, so the stepper's dt (the Euler step, the Heun scheme's
+ *  largest step) is dt * tau in the user's time; tau = 1 makes dt physical.
+ *  Since 0.2.7 it is honoured with flows and fixed forces too (0.2.6 and
+ *  older used it only for callback-driven runs and ignored it otherwise). */
 ODHS_API int odhs_driver_set_time_unit(odhs_driver *drv, double tau);
+/** Back to the natural time unit (undo odhs_driver_set_time_unit). Since 0.2.7. */
+ODHS_API int odhs_driver_clear_time_unit(odhs_driver *drv);
 
 /**
  * Self-propulsion for n particles in dimension dim (see above): magnitudes

@@ -85,6 +85,10 @@ ODHS_API int odhs_network_dim(const odhs_network *net);
 /** Contact k: particles (*i < *j), kind; any output may be NULL. */
 ODHS_API int odhs_network_get_contact(const odhs_network *net, size_t k, size_t *i, size_t *j,
                                       int *kind);
+/** Every contact at once: i[k] < j[k] and kind[k] for k < Nc (caller's
+ *  arrays of Nc entries; any may be NULL, not all). Walls: j = N + wall
+ *  index, as odhs_network_get_contact. Since 0.2.7. */
+ODHS_API int odhs_network_get_contacts(const odhs_network *net, size_t *i, size_t *j, int *kind);
 /** Copy per-contact data (Nc entries; normals Nc*dim) as of the last geometry
  *  update / force computation. */
 ODHS_API int odhs_network_get_forces(const odhs_network *net, double *f);

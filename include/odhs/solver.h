@@ -139,12 +139,22 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_auto;
 typedef struct odhs_solver odhs_solver; /* struct tag declared in network.h */
 
 /** Create a solver handle for a backend type (user or built-in). The table
- *  must outlive the handle. ODHS_E_INVALID for a malformed table. */
+ *  must outlive the handle. ODHS_E_INVALID for a malformed table (version
+ *  not in 1..ODHS_SOLVER_TYPE_VERSION, or no name, create, destroy or
+ *  solve); odhs_last_error() says which (as for every failure here). */
 ODHS_API int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out);
 /** Create a built-in solver by name: "cg", "dense", "auto", and with
  *  SuiteSparse "cholmod", "cholmod-pcg", "spqr". Names of backends not built into this
  *  library give ODHS_E_NOTINSTALLED; unknown names ODHS_E_INVALID. */
 ODHS_API int odhs_solver_create_by_name(const char *name, odhs_solver **out);
+/**
+ * The k-th built-in solver name (k = 0, 1, ... until ODHS_E_RANGE), in the
+ * order "auto", "cholmod", "cholmod-pcg", "spqr", "cg", "dense"; *installed
+ * (may be NULL) is 1 when this library was built with it (0: the name gives
+ * ODHS_E_NOTINSTALLED). *name is a static string. Since 0.2.7.
+ *     for (size_t k = 0; odhs_solver_list(k, &name, &ok) == ODHS_OK; ++k) ...
+ */
+ODHS_API int odhs_solver_list(size_t k, const char **name, int *installed);
 /** Destroy; NULL is a no-op. */
 ODHS_API void odhs_solver_destroy(odhs_solver *s);
 /** Last error message ("" if none). */

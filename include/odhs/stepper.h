@@ -11,9 +11,13 @@
  * (Appendix A). Every `correction_interval` steps the contact-distance drift
  * is removed (Sect. IV C).
  *
- * The stepper borrows the system, driver and solver: they must outlive it and
- * must not be modified behind its back while it runs (change them, then call
- * odhs_stepper_reset).
+ * The stepper borrows the system, driver and solver: they must outlive it.
+ * Driver changes are picked up by the next step. The system must not be
+ * changed behind its back: since 0.2.7 the stepper compares the system's
+ * change count (odhs_system_change_count) with the one it last saw and
+ * refuses to step (ODHS_E_STATE) after odhs_system_set_positions, _scale_box,
+ * _set_radii etc. until odhs_stepper_reset is called (setting the values the
+ * system already holds is no change).
  *
  * Time is physical time; strain is the accumulated shear strain
  * integral(gammadot dt). At fixed volume the system's Lees-Edwards strain is
@@ -49,9 +53,10 @@ enum {
     ODHS_EVENT_OPENING = 2    /* a contact opened (its force reached zero)   */
 };
 
-/** One event. Passed to callbacks; may gain fields at the end in later
- *  versions, so never allocate it by value across a library upgrade boundary
- *  except as returned by the library. */
+/** One event. Its layout is frozen (since 0.2.7: it never gains fields), so
+ *  callers may allocate it for odhs_stepper_step; more about a step comes in
+ *  odhs_step_info (odhs_stepper_step_ex), which carries its size. (0.2.6 and
+ *  older said it might gain fields; none was ever added.) */
 typedef struct odhs_event {
     int kind;      /* ODHS_EVENT_*                                   */
     size_t i, j;   /* the pair, i < j                                */
@@ -63,12 +68,16 @@ typedef struct odhs_event {
  *  current step (the run call then returns ODHS_STOPPED). */
 typedef int (*odhs_event_fn)(const odhs_event *ev, void *ctx);
 
-/** Create a stepper on sys (must be ready: radii and positions set). */
+/** Create a stepper on sys (must be ready: radii and positions set).
+ *  On failure odhs_last_error() says why. */
 ODHS_API int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
                                  odhs_stepper **out);
 /** Destroy; NULL is a no-op. The system keeps its current configuration. */
 ODHS_API void odhs_stepper_destroy(odhs_stepper *st);
-/** Last error message ("" if none). */
+/** The message of the last failed call on this stepper ("" if none).
+ *  Since 0.2.7 a successful call that changes the stepper (settings,
+ *  reset, step, run, correct) clears it; read-only calls leave it. The
+ *  create failure's message: odhs_last_error() (common.h). */
 ODHS_API const char *odhs_stepper_errmsg(const odhs_stepper *st);
 
 /** Integrators (pinned values). */
@@ -134,6 +143,65 @@ ODHS_API int odhs_stepper_correct(odhs_stepper *st);
  * of the step).
  */
 ODHS_API int odhs_stepper_step(odhs_stepper *st, odhs_event *ev);
+/**
+ * What one step did (odhs_stepper_step_ex). The caller sets `size` to
+ * sizeof(odhs_step_info) of the header it was compiled with; the library
+ * fills only that many bytes, so a program built against an older, smaller
+ * struct keeps working with a newer library, and fields a newer header adds
+ * (only ever at the end) are left as the caller set them by an older
+ * library: zero-initialise the struct. Since 0.2.7.
+ */
+typedef struct odhs_step_info {
+    size_t size;           /* set by the caller: sizeof(odhs_step_info)          */
+    int kind;              /* the step's first event: ODHS_EVENT_* (NONE if none) */
+    size_t i, j;           /* ... its pair, i < j                                */
+    double event_time;     /* ... its time                                       */
+    double event_strain;   /* ... its accumulated strain                         */
+    uint64_t collisions;   /* contacts formed in this step                      */
+    uint64_t openings;     /* contacts opened in this step                      */
+    double time_start;     /* physical time at the start of the step            */
+    double time_end;       /* ... and at its end                                */
+    double strain_start;   /* accumulated strain at the start of the step       */
+    double strain_end;     /* ... and at its end                                */
+    int advanced;          /* 1 if the time moved (time_end > time_start)       */
+    int driver_change;     /* 1 if the step only applied a change of the driver
+                            * that opened or closed contacts: events at the
+                            * current time and no motion (advanced = 0)        */
+} odhs_step_info;
+
+/**
+ * Take one step like odhs_stepper_step and describe it in *info (which
+ * must have info->size set, at least offsetof(odhs_step_info, kind) +
+ * sizeof(int): else ODHS_E_INVALID). Steps that do not advance the time
+ * (after the driver changed, see driver_change; or a collision at the
+ * step's start) say so in `advanced`. Returns as odhs_stepper_step; *info
+ * is written when the step was taken (ODHS_OK, ODHS_STOPPED, ODHS_JAMMED,
+ * ODHS_POTENTIALLY_JAMMED) and left alone on an error. Since 0.2.7.
+ */
+ODHS_API int odhs_stepper_step_ex(odhs_stepper *st, odhs_step_info *info);
+
+/**
+ * Guards of the run calls below (run_until_time, _strain,
+ * _packing_fraction, run_events), so that no input makes them loop forever:
+ *  - max_steps: the most steps one run call takes (0, the default: no cap);
+ *    reaching it returns ODHS_STEP_LIMIT (a positive status: the state is
+ *    valid and a new call goes on).
+ *  - stall_steps: a run returns ODHS_E_STALLED after this many steps in a
+ *    row that move neither the time, the strain nor the event count
+ *    (default 1000; 0 disables), e.g. a step dt * tau below the resolution
+ *    of the time. run_events also returns ODHS_E_STALLED at once when no
+ *    event can happen (no flow or pressure control, forces that do not
+ *    change with time, every particle moving with the same velocity: an
+ *    empty driver, uniform gravity on equal particles in a periodic box);
+ *    in other scenes where events are possible but may never come (two
+ *    discs drifting past each other), only max_steps bounds it.
+ * Also, run_until_time and _strain refuse (ODHS_E_INVALID) a target more
+ * than 1e15 largest steps (dt * tau) away. Since 0.2.7.
+ */
+ODHS_API int odhs_stepper_set_run_limits(odhs_stepper *st, uint64_t max_steps, uint64_t stall_steps);
+/** The run limits (either output may be NULL). Since 0.2.7. */
+ODHS_API int odhs_stepper_get_run_limits(const odhs_stepper *st, uint64_t *max_steps, uint64_t *stall_steps);
+
 /** Step until physical time t (the last step is truncated to land on t). */
 ODHS_API int odhs_stepper_run_until_time(odhs_stepper *st, double t);
 /** Step until accumulated strain gamma (shear rate must be nonzero). */
@@ -199,6 +267,19 @@ ODHS_API int odhs_stepper_nonaffine_velocities(const odhs_stepper *st, double *U
  * has none. Since 0.2.6.
  */
 ODHS_API int odhs_stepper_external_forces(const odhs_stepper *st, double *F);
+/**
+ * The current contacts in one call, into the caller's arrays (the caller
+ * owns them; the library keeps no pointer): pairs i[k] < j[k] (j = N + w
+ * for wall w), kind[k] (ODHS_CONTACT_*), force f[k] (>= 0 on a valid
+ * network; eq. 30's f_c) and gap[k] (r - a_i - a_j, or the wall gap), for
+ * k < Nc; any array may be NULL. *nc receives Nc. When cap < Nc nothing is
+ * written except *nc and the call returns ODHS_E_RANGE: call with cap = 0
+ * to learn the size. The same order as odhs_network_get_contact on
+ * odhs_stepper_network. ODHS_E_STATE before the first reset or step.
+ * Since 0.2.7.
+ */
+ODHS_API int odhs_stepper_contacts(const odhs_stepper *st, size_t cap, size_t *nc, size_t *i, size_t *j, int *kind,
+                                   double *f, double *gap);
 /** Mean coordination z = 2 Nc / N. */
 ODHS_API int odhs_stepper_coordination(const odhs_stepper *st, double *z);
 /** Optional features whose code a scene runs only when it uses them (pinned

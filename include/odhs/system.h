@@ -57,6 +57,15 @@ ODHS_API size_t odhs_system_count(const odhs_system *sys);
 /** Whether both radii and positions have been set (1) or not (0). */
 ODHS_API int odhs_system_is_ready(const odhs_system *sys);
 
+/** How many times the public setters (set_box, set_strain, set_radii,
+ *  set_positions, set_configuration, scale_box, set_radii_bidisperse,
+ *  place_random) changed the box, strain, radii or positions: a call that
+ *  writes the values already held does not count. The stepper moves
+ *  particles without counting; it remembers the count it last saw and
+ *  refuses to step (ODHS_E_STATE) after a change behind its back until
+ *  odhs_stepper_reset (stepper.h). Species labels do not count. Since 0.2.7. */
+ODHS_API int odhs_system_change_count(const odhs_system *sys, uint64_t *count);
+
 /**
  * Set the box edge lengths L[0..dim-1] (scales nothing: positions are wrapped
  * into the new box and checked for overlaps if radii and positions are set).

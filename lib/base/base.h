@@ -52,6 +52,13 @@ int64_t odhs__fault_live(void);
 /* Format into buf (ODHS_ERRMSG_LEN) and return status. */
 int odhs__err(char *buf, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
 int odhs__verr(char *buf, int status, const char *fmt, va_list ap);
+/* set the thread's odhs_last_error() message and return status */
+int odhs__create_err(int status, const char *fmt, ...) ODHS_PRINTF(2, 3);
+/* a create function's bracket: begin clears odhs_last_error(); end returns
+ * status, clearing the message on ODHS_OK and, on failure, setting
+ * odhs_strerror(status) unless the call set a message (odhs__create_err) */
+void odhs__create_begin(void);
+int odhs__create_end(int status);
 
 /* ---- random numbers: xoshiro256** seeded by splitmix64 --------------- */
 typedef struct {

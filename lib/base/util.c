@@ -35,6 +35,8 @@ const char *odhs_strerror(int status)
     case ODHS_E_UNSUPPORTED: return "unsupported combination of settings";
     case ODHS_E_TOODENSE: return "random placement cannot reach the requested packing fraction";
     case ODHS_E_INTERNAL: return "internal error";
+    case ODHS_STEP_LIMIT: return "the run reached its step limit before the target";
+    case ODHS_E_STALLED: return "no progress: the run's target does not advance";
     default: return "unknown status code";
     }
 }
@@ -124,6 +126,30 @@ int odhs__err(char *buf, int status, const char *fmt, ...)
     va_start(ap, fmt);
     odhs__verr(buf, status, fmt, ap);
     va_end(ap);
+    return status;
+}
+
+/* ---- the last error of a call without a handle (create functions) ------
+ * Thread-local, so separate threads (and their handles) stay independent. */
+static _Thread_local char last_error[ODHS_ERRMSG_LEN];
+
+const char *odhs_last_error(void) { return last_error; }
+
+int odhs__create_err(int status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    odhs__verr(last_error, status, fmt, ap);
+    va_end(ap);
+    return status;
+}
+
+void odhs__create_begin(void) { last_error[0] = '\0'; }
+
+int odhs__create_end(int status)
+{
+    if (status == ODHS_OK) last_error[0] = '\0';
+    else if (!last_error[0]) odhs__create_err(status, "%s", odhs_strerror(status));
     return status;
 }
 

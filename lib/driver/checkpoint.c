@@ -1,8 +1,8 @@
 /* libodhs - the driver's checkpoint sections (include/odhs/checkpoint.h,
  * lib/io/ckpt.h): DRV (flow, pressure, fixed forces), and after the contacts
  * the optional PROP (self-propulsion), GRAV (gravity), DRVC (the driver
- * changed after the forces were solved), OSC (oscillatory shear) and PJAM
- * (a finite jamming pressure).
+ * changed after the forces were solved), OSC (oscillatory shear), PJAM
+ * (a finite jamming pressure) and FCB (a force callback was set: since 0.2.7).
  *
  * A new optional section of the driver: write it in
  * odhs__ckpt_write_driver_tail (returning 2, the format version it needs) and
@@ -110,7 +110,14 @@ unsigned odhs__ckpt_write_driver_tail(odhs__wbuf *b, const odhs__ckpt_out *o)
         odhs__put_tag(b, "PJAM");
         odhs__put_f64(b, drv->p_jam);
     }
-    return drv->prop_on || drv->grav_on || o->drv_stale || drv->osc_shape || pjam ? 2u : 1u;
+    /* a force callback is code: it is not saved, but that it was set is, so
+     * that the restored stepper cannot continue silently without it */
+    if (drv->fn || drv->fn_missing) {
+        odhs__put_tag(b, "FCB ");
+        odhs__put_u64(b, 1u);
+    }
+    return drv->prop_on || drv->grav_on || o->drv_stale || drv->osc_shape || pjam || drv->fn || drv->fn_missing ? 2u
+                                                                                                                 : 1u;
 }
 
 /* the readers of the optional sections: 1 read, 0 read before, or an error */
@@ -206,10 +213,21 @@ static int read_pjam(odhs__ckpt_in *in)
     return 1;
 }
 
+/* the run had a force callback: the restored driver needs it set again */
+static int read_fcb(odhs__ckpt_in *in)
+{
+    if (in->drv->fn_missing) return 0;
+    if (odhs__get_u64(&in->b) != 1u || in->b.bad)
+        return odhs__ckpt_bad(in, "checkpoint: force-callback section malformed");
+    in->drv->fn_missing = 1;
+    return 1;
+}
+
 static const struct {
     char tag[5];
     int (*read)(odhs__ckpt_in *in);
-} tail[] = {{"PROP", read_prop}, {"GRAV", read_grav}, {"DRVC", read_drvc}, {"OSC ", read_osc}, {"PJAM", read_pjam}};
+} tail[] = {{"PROP", read_prop}, {"GRAV", read_grav}, {"DRVC", read_drvc}, {"OSC ", read_osc}, {"PJAM", read_pjam},
+          {"FCB ", read_fcb}};
 
 int odhs__ckpt_read_driver_tail(odhs__ckpt_in *in, const char *tag)
 {

@@ -1,4 +1,5 @@
 /* libodhs - drivers: affine flow (shear, compression, fixed pressure), forces. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -17,16 +18,22 @@ int odhs__drverr(const odhs_driver *d, int status, const char *fmt, ...)
 static double prop_f2(const odhs_driver *d);
 static double grav_weight(const odhs_driver *d, const odhs_system *sys, size_t i, double amean);
 
-int odhs_driver_create(odhs_driver **out)
+static int driver_create_impl(odhs_driver **out)
 {
-    if (!out) return ODHS_E_NULL;
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_driver_create: out is NULL");
     odhs_driver *d = odhs__calloc(1, sizeof *d);
     *out = d;
-    if (!d) return ODHS_E_NOMEM;
+    if (!d) return odhs__create_err(ODHS_E_NOMEM, "odhs_driver_create: out of memory");
     d->xi0 = 1.0;
     d->kappa_max = 100.0;
     d->p_jam = INFINITY;
     return ODHS_OK;
+}
+
+int odhs_driver_create(odhs_driver **out)
+{
+    odhs__create_begin();
+    return odhs__create_end(driver_create_impl(out));
 }
 
 void odhs_driver_destroy(odhs_driver *drv)
@@ -46,6 +53,7 @@ const char *odhs_driver_errmsg(const odhs_driver *drv) { return drv ? drv->errms
 int odhs_driver_set_mobility(odhs_driver *drv, double xi0)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(xi0)) return odhs__drverr(drv, ODHS_E_NONFINITE, "mobility is not finite");
     if (!(xi0 > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "mobility %g must be > 0", xi0);
     drv->xi0 = xi0;
@@ -56,6 +64,7 @@ int odhs_driver_set_mobility(odhs_driver *drv, double xi0)
 int odhs_driver_set_shear_rate(odhs_driver *drv, double gammadot)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(gammadot)) return odhs__drverr(drv, ODHS_E_NONFINITE, "shear rate is not finite");
     drv->gdot = gammadot;
     drv->osc_shape = 0; /* a constant rate replaces an oscillation */
@@ -66,6 +75,7 @@ int odhs_driver_set_shear_rate(odhs_driver *drv, double gammadot)
 int odhs_driver_set_compression_rate(odhs_driver *drv, double c)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(c)) return odhs__drverr(drv, ODHS_E_NONFINITE, "compression rate is not finite");
     drv->crate = c;
     drv->version++;
@@ -75,6 +85,7 @@ int odhs_driver_set_compression_rate(odhs_driver *drv, double c)
 int odhs_driver_set_pressure(odhs_driver *drv, double p)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(p)) return odhs__drverr(drv, ODHS_E_NONFINITE, "pressure is not finite");
     if (!(p > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "pressure %g must be > 0", p);
     drv->p = p;
@@ -86,6 +97,7 @@ int odhs_driver_set_pressure(odhs_driver *drv, double p)
 int odhs_driver_clear_pressure(odhs_driver *drv)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     drv->pressure_on = 0;
     drv->p = 0.0;
     drv->version++;
@@ -95,6 +107,7 @@ int odhs_driver_clear_pressure(odhs_driver *drv)
 int odhs_driver_set_kappa_max(odhs_driver *drv, double kappa_max)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(kappa_max)) return odhs__drverr(drv, ODHS_E_NONFINITE, "kappa_max is not finite");
     if (!(kappa_max > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "kappa_max must be > 0");
     drv->kappa_max = kappa_max;
@@ -105,6 +118,7 @@ int odhs_driver_set_kappa_max(odhs_driver *drv, double kappa_max)
 int odhs_driver_set_jamming_pressure(odhs_driver *drv, double p_jam)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (isnan(p_jam)) return odhs__drverr(drv, ODHS_E_NONFINITE, "jamming pressure is NaN");
     if (!(p_jam >= 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "jamming pressure must be >= 0");
     drv->p_jam = p_jam;
@@ -123,6 +137,7 @@ int odhs_driver_get_jamming_pressure(const odhs_driver *drv, double *p_jam)
 int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const double *F)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!F) {
         odhs__free(drv->F);
         drv->F = NULL;
@@ -144,6 +159,7 @@ int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const double *F)
     drv->Fdim = dim;
     drv->fn = NULL;
     drv->fn_ctx = NULL;
+    drv->fn_missing = 0; /* fixed forces replace the callback of a checkpoint */
     drv->version++;
     return ODHS_OK;
 }
@@ -151,8 +167,10 @@ int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const double *F)
 int odhs_driver_set_force_callback(odhs_driver *drv, odhs_force_fn fn, void *ctx)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     drv->fn = fn;
     drv->fn_ctx = fn ? ctx : NULL;
+    drv->fn_missing = 0; /* set (or explicitly removed) after a checkpoint */
     if (fn) {
         odhs__free(drv->F);
         drv->F = NULL;
@@ -165,12 +183,24 @@ int odhs_driver_set_force_callback(odhs_driver *drv, odhs_force_fn fn, void *ctx
 int odhs_driver_set_time_unit(odhs_driver *drv, double tau)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(tau)) return odhs__drverr(drv, ODHS_E_NONFINITE, "time unit is not finite");
     if (!(tau > 0.0)) return odhs__drverr(drv, ODHS_E_INVALID, "time unit must be > 0");
     drv->tau_user = tau;
     drv->version++;
     return ODHS_OK;
 }
+
+int odhs_driver_clear_time_unit(odhs_driver *drv)
+{
+    if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
+    if (drv->tau_user != 0.0) drv->version++;
+    drv->tau_user = 0.0;
+    return ODHS_OK;
+}
+
+
 
 int odhs_driver_get_shear_rate(const odhs_driver *drv, double *g)
 {
@@ -205,52 +235,77 @@ int odhs_driver_get_pressure(const odhs_driver *drv, double *p, int *enabled)
     return ODHS_OK;
 }
 
+/* the natural time unit (see driver.h), or 0 when the forces set none.
+ * The force scale f_ext = sqrt(<F_d|F_d>/N + <|F_p|^2>) is summed as in
+ * 0.2.6 (bit for bit) while the sum of squares is a normal double, else
+ * again with scaling, so that forces of 1e200 or 1e-200 give their time
+ * unit instead of 0 or infinity. */
+static double natural_time_unit(const odhs_driver *drv, const odhs_system *sys, double lam)
+{
+    double rate = fmax(fabs(drv->gdot), fabs(drv->crate));
+    if (rate > 0.0) return 1.0 / rate;
+    int dim = sys->dim;
+    int grav = drv->grav_on && odhs__driver_check_extra(drv, sys->n, sys->dim) == ODHS_OK;
+    if (!grav && !drv->F && !drv->prop_on) return 0.0;
+    int fixed = grav ? drv->F && drv->Fn == sys->n && drv->Fdim == dim : drv->F != NULL;
+    size_t n = grav ? sys->n : drv->F ? drv->Fn : sys->n;
+    int fd_dim = grav ? dim : drv->F ? drv->Fdim : dim;
+    double amean = 0.5 * lam, amax = 0.0, s = 0.0, ss = 0.0;
+    for (int pass = 0; pass < 2; ++pass)
+        for (size_t i = 0; i < n && (grav || fixed); ++i) {
+            double w = grav ? grav_weight(drv, sys, i, amean) : 0.0;
+            for (int k = 0; k < fd_dim; ++k) {
+                double f = (grav ? w * drv->g[k] : 0.0) + (fixed ? drv->F[i * fd_dim + k] : 0.0);
+                if (pass == 0) {
+                    amax = fmax(amax, fabs(f));
+                    s += f * f;
+                } else {
+                    ss += (f / amax) * (f / amax);
+                }
+            }
+            if (pass == 1 && !(amax > 0.0)) break;
+        }
+    double f2p = drv->prop_on ? prop_f2(drv) : 0.0;
+    double f2 = s / (double)n + f2p;
+    if (isfinite(f2) && (f2 >= 0x1p-900 || amax == 0.0) && f2 > 0.0) return lam / (drv->xi0 * sqrt(f2));
+    /* the scaled route: fd the rms of the deterministic forces */
+    double fd = amax > 0.0 ? amax * sqrt(ss / (double)n) : 0.0;
+    double fp = drv->prop_on ? odhs__prop_fp(drv) : 0.0;
+    double fm = fmax(fd, fp);
+    if (!(fm > 0.0)) return 0.0;
+    double fext = fm * sqrt((fd / fm) * (fd / fm) + (fp / fm) * (fp / fm));
+    return lam / (drv->xi0 * fext);
+}
+
+int odhs__driver_check_rates(const odhs_driver *d, const odhs_system *sys, char *errbuf)
+{
+    double rate = odhs__flow_rate_scale(d);
+    if (!(rate > 0.0)) return ODHS_OK;
+    double L = fmax(sys->L[0], fmax(sys->L[1], sys->dim == 3 ? sys->L[2] : 0.0)), v = rate * L;
+    if (v <= ODHS_VMAX && v >= ODHS_VMIN) return ODHS_OK;
+    return odhs__err(errbuf, ODHS_E_INVALID,
+                     "flow rate %g over a box edge %g: affine velocities outside [%g, %g], where their squares over- "
+                     "or underflow; change the units of time",
+                     rate, L, ODHS_VMIN, ODHS_VMAX);
+}
+
 int odhs_driver_time_unit(const odhs_driver *drv, const odhs_system *sys, double *tau)
 {
     if (!drv) return ODHS_E_NULL;
     if (!sys || !tau) return odhs__drverr(drv, ODHS_E_NULL, "NULL argument");
     if (!sys->has_r) return odhs__drverr(drv, ODHS_E_STATE, "system radii are not set");
-    double rate = fmax(fabs(drv->gdot), fabs(drv->crate));
-    if (rate > 0.0) {
-        *tau = 1.0 / rate;
-        return ODHS_OK;
-    }
     double lam = 0.0;
     for (size_t i = 0; i < sys->n; ++i) lam += 2.0 * sys->r[i];
     lam /= (double)sys->n;
-    if (drv->grav_on && odhs__driver_check_extra(drv, sys->n, sys->dim) == ODHS_OK) {
-        /* deterministic forces: fixed plus gravity, summed per particle */
-        double s = 0.0, amean = 0.5 * lam;
-        int dim = sys->dim;
-        int fixed = drv->F && drv->Fn == sys->n && drv->Fdim == dim;
-        for (size_t i = 0; i < sys->n; ++i) {
-            double w = grav_weight(drv, sys, i, amean);
-            for (int k = 0; k < dim; ++k) {
-                double f = w * drv->g[k] + (fixed ? drv->F[i * dim + k] : 0.0);
-                s += f * f;
-            }
-        }
-        double f2 = s / (double)sys->n + (drv->prop_on ? prop_f2(drv) : 0.0);
-        if (f2 > 0.0) {
-            *tau = lam / (drv->xi0 * sqrt(f2));
-            return ODHS_OK;
-        }
-    } else if (drv->F) {
-        double s = 0.0;
-        size_t nd = drv->Fn * (size_t)drv->Fdim;
-        for (size_t k = 0; k < nd; ++k) s += drv->F[k] * drv->F[k];
-        double f2 = s / (double)drv->Fn;
-        if (drv->prop_on) f2 += prop_f2(drv);
-        double frms = sqrt(f2);
-        if (frms > 0.0) {
-            *tau = lam / (drv->xi0 * frms);
-            return ODHS_OK;
-        }
-    } else if (drv->prop_on) {
-        *tau = lam / (drv->xi0 * odhs__prop_fp(drv));
-        return ODHS_OK;
-    }
-    *tau = drv->tau_user > 0.0 ? drv->tau_user : lam / drv->xi0;
+    double t = drv->tau_user > 0.0 ? drv->tau_user : natural_time_unit(drv, sys, lam);
+    if (t == 0.0) t = lam / drv->xi0; /* nothing sets a scale: unit force */
+    /* a unit of time that is 0, subnormal or infinite cannot time steps */
+    if (!(t >= DBL_MIN) || !(t <= DBL_MAX))
+        return odhs__drverr(drv, ODHS_E_INVALID,
+                            "the time unit %g (lambda %g / (xi0 %g * force scale)) is out of the range of doubles: "
+                            "rescale the forces or the mobility, or set a time unit (odhs_driver_set_time_unit)",
+                            t, lam, drv->xi0);
+    *tau = t;
     return ODHS_OK;
 }
 
@@ -328,6 +383,7 @@ int odhs_driver_set_self_propulsion(odhs_driver *drv, size_t n, int dim, double 
                                     double tmax, uint64_t seed)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (dim != 2 && dim != 3) return odhs__drverr(drv, ODHS_E_DIM, "dimension %d must be 2 or 3", dim);
     if (n == 0) return odhs__drverr(drv, ODHS_E_EMPTY, "no particles");
     if (!isfinite(fmin) || !isfinite(fmax) || !isfinite(tmin) || !isfinite(tmax))
@@ -355,6 +411,7 @@ int odhs_driver_set_self_propulsion(odhs_driver *drv, size_t n, int dim, double 
 int odhs_driver_clear_self_propulsion(odhs_driver *drv)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (drv->prop_on) {
         prop_free(drv);
         drv->version++;
@@ -435,6 +492,7 @@ void odhs__prop_restore(odhs_driver *d)
 int odhs_driver_set_gravity(odhs_driver *drv, int dim, const double *g)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!g) {
         if (drv->grav_on) drv->version++;
         drv->grav_on = 0;
@@ -455,6 +513,7 @@ int odhs_driver_set_gravity(odhs_driver *drv, int dim, const double *g)
 int odhs_driver_set_gravity_weights(odhs_driver *drv, size_t n, const double *w)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!w) {
         odhs__free(drv->gw);
         drv->gw = NULL;

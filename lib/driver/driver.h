@@ -23,6 +23,9 @@ struct odhs_driver {
     odhs_force_fn fn;
     void *fn_ctx;
     double tau_user;   /* 0 = unset */
+    int fn_missing;    /* read from a checkpoint of a run with a force callback:
+                        * steppers refuse to step until the callback (or
+                        * fixed forces) is set again */
     uint64_t version;  /* bumped by every setter: steppers re-solve on change */
     char errmsg[ODHS_ERRMSG_LEN];
     /* self-propulsion (Sect. V B); switches do not bump version: the stepper
@@ -50,6 +53,17 @@ struct odhs_driver {
 
 /* record an error message on the driver (logically mutable) */
 int odhs__drverr(const odhs_driver *d, int status, const char *fmt, ...) ODHS_PRINTF(3, 4);
+
+/* The range of velocity scales the stepper computes with: velocities are
+ * squared (collision prediction, error estimates, skins), so xi0 |F| and
+ * rate * box edge must stay where squares neither over- nor underflow. */
+#define ODHS_VMAX 1e150
+#define ODHS_VMIN 1e-150
+/* the largest rate of the affine flow (max |gammadot|, |c|); 0 without one */
+static inline double odhs__flow_rate_scale(const odhs_driver *d) { return fmax(fabs(d->gdot), fabs(d->crate)); }
+/* ODHS_OK, or ODHS_E_INVALID with a message in errbuf when a flow rate
+ * times the box edge leaves [ODHS_VMIN, ODHS_VMAX] */
+int odhs__driver_check_rates(const odhs_driver *d, const odhs_system *sys, char *errbuf);
 
 /* propulsion and gravity (lib/driver/driver.c) */
 double odhs__prop_fp(const odhs_driver *d);               /* sqrt(<|F_p|^2>) */

@@ -9,6 +9,7 @@
 int odhs_driver_set_oscillatory_shear(odhs_driver *drv, int shape, double amplitude, double period, double t0)
 {
     if (!drv) return ODHS_E_NULL;
+    drv->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(amplitude) || !isfinite(period) || !isfinite(t0))
         return odhs__drverr(drv, ODHS_E_NONFINITE, "oscillatory shear: amplitude, period and phase origin must be finite");
     if (shape != ODHS_OSCILLATION_SINE && shape != ODHS_OSCILLATION_TRIANGLE)

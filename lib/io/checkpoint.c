@@ -237,6 +237,7 @@ static int finish(odhs__ckpt_in *in)
     /* a driver changed after the last solve is re-solved by the next step,
      * as it would have been without the checkpoint */
     st->drv_version = in->drv_changed ? drv->version - 1 : drv->version;
+    st->sys_version = sys->version;
     st->ready = 1;
     return ODHS_OK;
 }

@@ -249,6 +249,7 @@ static int reserve_frame(odhs_traj *tr, const odhs_system *sys, int velocities)
 int odhs_traj_write(odhs_traj *tr, const odhs_system *sys, const odhs_stepper *st)
 {
     if (!tr) return ODHS_E_NULL;
+    tr->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!sys) return trerr(tr, ODHS_E_NULL, "system is NULL");
     if (!st && tr->format == ODHS_TRAJ_LAMMPS_LOCAL)
         return trerr(tr, ODHS_E_NULL, "a contact-network trajectory needs the stepper");

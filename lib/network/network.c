@@ -108,13 +108,19 @@ odhs_network *odhs__net_new(int dim, size_t n)
     return net;
 }
 
+static int network_create_impl(const odhs_system *sys, odhs_network **out)
+{
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_network_create: out is NULL");
+    *out = NULL;
+    if (!sys) return odhs__create_err(ODHS_E_NULL, "odhs_network_create: system is NULL");
+    *out = odhs__net_new(sys->dim, sys->n);
+    return *out ? ODHS_OK : odhs__create_err(ODHS_E_NOMEM, "odhs_network_create: out of memory (N = %zu)", sys->n);
+}
+
 int odhs_network_create(const odhs_system *sys, odhs_network **out)
 {
-    if (!out) return ODHS_E_NULL;
-    *out = NULL;
-    if (!sys) return ODHS_E_NULL;
-    *out = odhs__net_new(sys->dim, sys->n);
-    return *out ? ODHS_OK : ODHS_E_NOMEM;
+    odhs__create_begin();
+    return odhs__create_end(network_create_impl(sys, out));
 }
 
 void odhs_network_destroy(odhs_network *net)
@@ -275,6 +281,7 @@ void odhs__net_remove_at(odhs_network *net, size_t k)
 int odhs_network_add(odhs_network *net, size_t i, size_t j, int kind)
 {
     if (!net) return ODHS_E_NULL;
+    net->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (i >= net->n || j >= net->n)
         return odhs__neterr(net, ODHS_E_RANGE, "particle index out of range (N = %zu)", net->n);
     if (i == j) return odhs__neterr(net, ODHS_E_INVALID, "a contact needs two different particles");
@@ -289,6 +296,7 @@ int odhs_network_add(odhs_network *net, size_t i, size_t j, int kind)
 int odhs_network_remove(odhs_network *net, size_t i, size_t j)
 {
     if (!net) return ODHS_E_NULL;
+    net->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (i >= net->n || j >= net->n)
         return odhs__neterr(net, ODHS_E_RANGE, "particle index out of range (N = %zu)", net->n);
     size_t k = odhs__net_find(net, i, j);
@@ -300,6 +308,7 @@ int odhs_network_remove(odhs_network *net, size_t i, size_t j)
 int odhs_network_clear(odhs_network *net)
 {
     if (!net) return ODHS_E_NULL;
+    net->errmsg[0] = '\0'; /* a successful call leaves no message */
     while (net->nc) odhs__net_remove_at(net, net->nc - 1);
     return ODHS_OK;
 }
@@ -350,6 +359,7 @@ static int check_sys(const odhs_network *net, const odhs_system *sys)
 int odhs_network_update_geometry(odhs_network *net, const odhs_system *sys)
 {
     if (!net) return ODHS_E_NULL;
+    net->errmsg[0] = '\0'; /* a successful call leaves no message */
     int st = check_sys(net, sys);
     if (st) return st;
     odhs__net_geometry(net, sys);
@@ -396,6 +406,7 @@ static int same_normal_wall(const odhs_network *net, const odhs_system *sys, siz
 int odhs_network_detect(odhs_network *net, const odhs_system *sys, double tol)
 {
     if (!net) return ODHS_E_NULL;
+    net->errmsg[0] = '\0'; /* a successful call leaves no message */
     int st = check_sys(net, sys);
     if (st) return st;
     if (!isfinite(tol) || tol < 0.0) return odhs__neterr(net, ODHS_E_INVALID, "tolerance must be >= 0");
@@ -434,6 +445,16 @@ int odhs_network_get_contact(const odhs_network *net, size_t k, size_t *i, size_
     return ODHS_OK;
 }
 
+int odhs_network_get_contacts(const odhs_network *net, size_t *i, size_t *j, int *kind)
+{
+    if (!net) return ODHS_E_NULL;
+    if (!i && !j && !kind) return odhs__neterr(net, ODHS_E_NULL, "every output pointer is NULL");
+    if (i && net->nc) memcpy(i, net->ci, net->nc * sizeof *i);
+    if (j && net->nc) memcpy(j, net->cj, net->nc * sizeof *j);
+    for (size_t k = 0; kind && k < net->nc; ++k) kind[k] = net->kind[k];
+    return ODHS_OK;
+}
+
 static int copy_out(const odhs_network *net, const double *src, double *dst, size_t count)
 {
     if (!net) return ODHS_E_NULL;
@@ -458,6 +479,7 @@ int odhs_network_get_normals(const odhs_network *net, double *n)
 int odhs_network_set_forces(odhs_network *net, const double *f)
 {
     if (!net) return ODHS_E_NULL;
+    net->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!f && net->nc) return odhs__neterr(net, ODHS_E_NULL, "forces pointer is NULL");
     for (size_t c = 0; c < net->nc; ++c)
         if (!isfinite(f[c])) return odhs__neterr(net, ODHS_E_NONFINITE, "force %zu is not finite", c);
@@ -597,6 +619,7 @@ int odhs_network_coordination(const odhs_network *net, double *z)
 int odhs_network_add_bond(odhs_network *net, size_t i, size_t j, double rest)
 {
     if (!net) return ODHS_E_NULL;
+    net->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (i >= net->n || j >= net->n)
         return odhs__neterr(net, ODHS_E_RANGE, "particle index out of range (N = %zu)", net->n);
     if (i == j) return odhs__neterr(net, ODHS_E_INVALID, "a bond needs two different particles");

@@ -73,6 +73,7 @@ static int check_index(const odhs_stepper *st, size_t i)
 int odhs_stepper_add_bond(odhs_stepper *st, size_t i, size_t j, double rest)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     int s;
     if ((s = check_index(st, i)) || (s = check_index(st, j))) return s;
     if (i == j) return odhs__sterr(st, ODHS_E_INVALID, "a bond needs two different particles");
@@ -100,6 +101,7 @@ int odhs_stepper_add_bond(odhs_stepper *st, size_t i, size_t j, double rest)
 int odhs_stepper_add_chain(odhs_stepper *st, size_t k, const size_t *beads)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!beads) return odhs__sterr(st, ODHS_E_NULL, "beads pointer is NULL");
     if (k < 2) return odhs__sterr(st, ODHS_E_INVALID, "a chain needs at least 2 beads (got %zu)", k);
     int s;
@@ -298,6 +300,7 @@ static int make_body_bonds(odhs_stepper *st, const size_t *bi, const size_t *bj,
 int odhs_stepper_add_rigid_body(odhs_stepper *st, size_t k, const size_t *beads)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!beads) return odhs__sterr(st, ODHS_E_NULL, "beads pointer is NULL");
     if (k < 2) return odhs__sterr(st, ODHS_E_INVALID, "a rigid body needs at least 2 beads (got %zu)", k);
     odhs_network *net = st->net;

@@ -38,6 +38,7 @@ static int add_wall(odhs_stepper *st, odhs_wall *w, size_t *id)
 int odhs_stepper_add_wall_plane(odhs_stepper *st, const double *normal, double offset, size_t *id)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!normal) return odhs__sterr(st, ODHS_E_NULL, "normal is NULL");
     int dim = st->dim;
     if (!finite_vec(normal, dim) || !isfinite(offset)) return odhs__sterr(st, ODHS_E_NONFINITE, "wall plane is not finite");
@@ -56,6 +57,7 @@ int odhs_stepper_add_wall_plane(odhs_stepper *st, const double *normal, double o
 int odhs_stepper_add_wall_sphere(odhs_stepper *st, const double *centre, double radius, size_t *id)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!centre) return odhs__sterr(st, ODHS_E_NULL, "centre is NULL");
     int dim = st->dim;
     if (!finite_vec(centre, dim) || !isfinite(radius)) return odhs__sterr(st, ODHS_E_NONFINITE, "wall sphere is not finite");
@@ -71,6 +73,7 @@ int odhs_stepper_add_wall_sphere(odhs_stepper *st, const double *centre, double 
 int odhs_stepper_add_wall_segment(odhs_stepper *st, const double *a, const double *b, size_t *id)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!a || !b) return odhs__sterr(st, ODHS_E_NULL, "segment end is NULL");
     if (st->dim != 2) return odhs__sterr(st, ODHS_E_DIM, "segment walls are 2D only");
     if (!finite_vec(a, 2) || !finite_vec(b, 2)) return odhs__sterr(st, ODHS_E_NONFINITE, "segment is not finite");
@@ -98,6 +101,7 @@ static int check_id(const odhs_stepper *st, size_t id)
 int odhs_stepper_set_wall_velocity(odhs_stepper *st, size_t id, const double *v)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     int s = check_id(st, id);
     if (s) return s;
     if (!v) return odhs__sterr(st, ODHS_E_NULL, "velocity is NULL");

@@ -217,6 +217,7 @@ static int step_once(odhs_softcore *sc, double hmax, double *taken)
 int odhs_softcore_step(odhs_softcore *sc)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     double h;
     return step_once(sc, INFINITY, &h);
 }
@@ -224,6 +225,7 @@ int odhs_softcore_step(odhs_softcore *sc)
 int odhs_softcore_run_until_strain(odhs_softcore *sc, double gamma)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(gamma)) return odhs__scerr(sc, ODHS_E_NONFINITE, "target strain is not finite");
     if (sc->gdot == 0.0) return odhs__scerr(sc, ODHS_E_INVALID, "run_until_strain needs a nonzero shear rate");
     double rem = (gamma - sc->strain) / sc->gdot;
@@ -248,6 +250,7 @@ int odhs_softcore_run_until_strain(odhs_softcore *sc, double gamma)
 int odhs_softcore_run_until_time(odhs_softcore *sc, double t)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(t)) return odhs__scerr(sc, ODHS_E_NONFINITE, "target time is not finite");
     if (t < sc->time) return odhs__scerr(sc, ODHS_E_INVALID, "time %g lies before the current time %g", t, sc->time);
     while (sc->time < t) {

@@ -54,15 +54,18 @@ static void geometry(odhs_softcore *sc)
     sc->fc_ok = 0;
 }
 
-int odhs_softcore_create(odhs_system *sys, odhs_softcore **out)
+static int softcore_create_impl(odhs_system *sys, odhs_softcore **out)
 {
-    if (!out) return ODHS_E_NULL;
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_softcore_create: out is NULL");
     *out = NULL;
-    if (!sys) return ODHS_E_NULL;
-    if (!odhs_system_is_ready(sys))
-        return odhs__syserr(sys, ODHS_E_STATE, "softcore: the system needs radii and positions");
+    if (!sys) return odhs__create_err(ODHS_E_NULL, "odhs_softcore_create: system is NULL");
+    if (!odhs_system_is_ready(sys)) {
+        odhs__syserr(sys, ODHS_E_STATE, "softcore: the system needs radii and positions");
+        return odhs__create_err(ODHS_E_STATE, "odhs_softcore_create: the system needs radii and positions (%s)",
+                   sys->has_r ? "positions not set" : "radii not set");
+    }
     odhs_softcore *sc = odhs__calloc(1, sizeof *sc);
-    if (!sc) return ODHS_E_NOMEM;
+    if (!sc) return odhs__create_err(ODHS_E_NOMEM, "odhs_softcore_create: out of memory");
     sc->sys = sys;
     sc->dim = sys->dim;
     sc->n = sys->n;
@@ -101,6 +104,12 @@ nomem:
     return ODHS_E_NOMEM;
 }
 
+int odhs_softcore_create(odhs_system *sys, odhs_softcore **out)
+{
+    odhs__create_begin();
+    return odhs__create_end(softcore_create_impl(sys, out));
+}
+
 void odhs_softcore_destroy(odhs_softcore *sc)
 {
     if (!sc) return;
@@ -113,6 +122,7 @@ const char *odhs_softcore_errmsg(const odhs_softcore *sc) { return sc ? sc->errm
 int odhs_softcore_set_model(odhs_softcore *sc, int model)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (model < ODHS_SOFTCORE_RD0 || model > ODHS_SOFTCORE_CDT)
         return odhs__scerr(sc, ODHS_E_INVALID, "unknown soft-core model %d", model);
     sc->model = model;
@@ -124,6 +134,7 @@ int odhs_softcore_set_model(odhs_softcore *sc, int model)
 int odhs_softcore_set_potential(odhs_softcore *sc, double alpha, double k_e)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(alpha) || !isfinite(k_e)) return odhs__scerr(sc, ODHS_E_NONFINITE, "non-finite potential parameter");
     if (!(alpha > 1.0 && alpha <= 10.0))
         return odhs__scerr(sc, ODHS_E_INVALID, "alpha must be in (1, 10], got %g", alpha);
@@ -149,6 +160,7 @@ int odhs_softcore_set_potential(odhs_softcore *sc, double alpha, double k_e)
 int odhs_softcore_set_drag(odhs_softcore *sc, double kd)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(kd)) return odhs__scerr(sc, ODHS_E_NONFINITE, "drag coefficient k_d is not finite");
     if (!(kd >= 0.0)) return odhs__scerr(sc, ODHS_E_INVALID, "drag coefficient k_d must be >= 0, got %g", kd);
     sc->kd = kd;
@@ -161,6 +173,7 @@ POSITIVE_SETTER(odhs_softcore_set_mass, mass, "mass")
 int odhs_softcore_set_substrate(odhs_softcore *sc, double k0)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(k0)) return odhs__scerr(sc, ODHS_E_NONFINITE, "k_0 is not finite");
     if (!(k0 >= 0.0)) return odhs__scerr(sc, ODHS_E_INVALID, "k_0 must be >= 0, got %g", k0);
     sc->k0 = k0;
@@ -171,6 +184,7 @@ int odhs_softcore_set_substrate(odhs_softcore *sc, double k0)
 int odhs_softcore_set_shear_rate(odhs_softcore *sc, double g)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(g)) return odhs__scerr(sc, ODHS_E_NONFINITE, "shear rate is not finite");
     if (fabs(g) > 1e300) return odhs__scerr(sc, ODHS_E_INVALID, "shear rate %g too large", g);
     sc->gdot = g;
@@ -181,6 +195,7 @@ int odhs_softcore_set_shear_rate(odhs_softcore *sc, double g)
 int odhs_softcore_set_integrator(odhs_softcore *sc, int integ)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (integ != ODHS_SOFTCORE_FIXED && integ != ODHS_SOFTCORE_ADAPTIVE)
         return odhs__scerr(sc, ODHS_E_INVALID, "unknown integrator %d", integ);
     sc->integ = integ;
@@ -191,6 +206,7 @@ int odhs_softcore_set_integrator(odhs_softcore *sc, int integ)
 int odhs_softcore_set_dt(odhs_softcore *sc, double c)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(c)) return odhs__scerr(sc, ODHS_E_NONFINITE, "step factor is not finite");
     if (!(c > 0.0 && c <= 10.0)) return odhs__scerr(sc, ODHS_E_INVALID, "step factor must be in (0, 10], got %g", c);
     sc->cdt = c;
@@ -201,6 +217,7 @@ int odhs_softcore_set_dt(odhs_softcore *sc, double c)
 int odhs_softcore_set_tolerance(odhs_softcore *sc, double tol)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(tol)) return odhs__scerr(sc, ODHS_E_NONFINITE, "tolerance is not finite");
     if (!(tol > 0.0 && tol < 1.0)) return odhs__scerr(sc, ODHS_E_INVALID, "tolerance must be in (0, 1), got %g", tol);
     sc->tol = tol;
@@ -210,6 +227,7 @@ int odhs_softcore_set_tolerance(odhs_softcore *sc, double tol)
 int odhs_softcore_set_minimiser(odhs_softcore *sc, int m)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (m != ODHS_SOFTCORE_SD && m != ODHS_SOFTCORE_FIRE && m != ODHS_SOFTCORE_CG)
         return odhs__scerr(sc, ODHS_E_INVALID, "unknown minimiser %d", m);
     sc->minimiser = m;
@@ -219,6 +237,7 @@ int odhs_softcore_set_minimiser(odhs_softcore *sc, int m)
 int odhs_softcore_set_min_tolerance(odhs_softcore *sc, double tol, uint64_t max_iter)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(tol)) return odhs__scerr(sc, ODHS_E_NONFINITE, "minimiser tolerance is not finite");
     if (!(tol > 0.0)) return odhs__scerr(sc, ODHS_E_INVALID, "minimiser tolerance must be > 0, got %g", tol);
     if (max_iter == 0) return odhs__scerr(sc, ODHS_E_INVALID, "max_iter must be > 0");
@@ -230,6 +249,7 @@ int odhs_softcore_set_min_tolerance(odhs_softcore *sc, double tol, uint64_t max_
 int odhs_softcore_set_linear_tolerance(odhs_softcore *sc, double tol)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(tol)) return odhs__scerr(sc, ODHS_E_NONFINITE, "linear tolerance is not finite");
     if (!(tol > 0.0 && tol < 1.0))
         return odhs__scerr(sc, ODHS_E_INVALID, "linear tolerance must be in (0, 1), got %g", tol);
@@ -245,6 +265,7 @@ void odhs__sc_wrap_all(odhs_softcore *sc, double *x)
 int odhs_softcore_set_positions(odhs_softcore *sc, const double *x)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!x) return odhs__scerr(sc, ODHS_E_NULL, "positions are NULL");
     for (size_t k = 0; k < sc->nd; ++k)
         if (!isfinite(x[k])) return odhs__scerr(sc, ODHS_E_NONFINITE, "position %zu is not finite", k);
@@ -262,6 +283,7 @@ int odhs_softcore_set_positions(odhs_softcore *sc, const double *x)
 int odhs_softcore_scale_box(odhs_softcore *sc, double s)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(s)) return odhs__scerr(sc, ODHS_E_NONFINITE, "scale factor is not finite");
     if (!(s > 0.0)) return odhs__scerr(sc, ODHS_E_INVALID, "scale factor %g must be > 0", s);
     odhs_system *sys = sc->sys;
@@ -281,6 +303,7 @@ int odhs_softcore_scale_box(odhs_softcore *sc, double s)
 int odhs_softcore_set_velocities(odhs_softcore *sc, const double *u)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!u) return odhs__scerr(sc, ODHS_E_NULL, "velocities are NULL");
     for (size_t k = 0; k < sc->nd; ++k)
         if (!isfinite(u[k])) return odhs__scerr(sc, ODHS_E_NONFINITE, "velocity %zu is not finite", k);
@@ -291,6 +314,7 @@ int odhs_softcore_set_velocities(odhs_softcore *sc, const double *u)
 int odhs_softcore_reset(odhs_softcore *sc)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!odhs_system_is_ready(sc->sys)) return odhs__scerr(sc, ODHS_E_STATE, "the system is not ready");
     geometry(sc);
     sc->h_ad = 0.0;

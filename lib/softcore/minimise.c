@@ -182,6 +182,7 @@ static int minimise_inner(odhs_softcore *sc, uint64_t *iters)
 int odhs_softcore_minimise(odhs_softcore *sc, uint64_t *iterations)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     double gam, str, tim;
     uint64_t it = 0;
     odhs__sc_snapshot(sc, &gam, &str, &tim);
@@ -198,6 +199,7 @@ int odhs_softcore_minimise(odhs_softcore *sc, uint64_t *iterations)
 int odhs_softcore_quasistatic_step(odhs_softcore *sc, double dgamma, uint64_t *iterations)
 {
     SCNULL(sc);
+    sc->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(dgamma)) return odhs__scerr(sc, ODHS_E_NONFINITE, "strain step is not finite");
     if (dgamma == 0.0 || fabs(dgamma) > 0.1)
         return odhs__scerr(sc, ODHS_E_INVALID, "strain step must be nonzero and at most 0.1, got %g", dgamma);

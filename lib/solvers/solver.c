@@ -16,44 +16,113 @@ static int solerr(const odhs_solver *s, int status, const char *fmt, ...)
     return status;
 }
 
-int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out)
+static int solver_create_impl(const odhs_solver_type *type, odhs_solver **out)
 {
-    if (!out) return ODHS_E_NULL;
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_solver_create: out is NULL");
     *out = NULL;
-    if (!type) return ODHS_E_NULL;
-    if (type->version < 1 || type->version > ODHS_SOLVER_TYPE_VERSION || !type->name || !type->create ||
-        !type->destroy || !type->solve)
-        return ODHS_E_INVALID;
+    if (!type) return odhs__create_err(ODHS_E_NULL, "odhs_solver_create: solver type is NULL");
+    if (type->version < 1 || type->version > ODHS_SOLVER_TYPE_VERSION)
+        return odhs__create_err(ODHS_E_INVALID,
+                                "odhs_solver_create: solver type version %d is not in 1..%d (set ODHS_SOLVER_TYPE_VERSION)",
+                                type->version, ODHS_SOLVER_TYPE_VERSION);
+    if (!type->name || !type->create || !type->destroy || !type->solve)
+        return odhs__create_err(ODHS_E_INVALID, "odhs_solver_create: the solver type has no %s (name, create, destroy "
+                                "and solve are required)",
+                                !type->name ? "name" : !type->create ? "create" : !type->destroy ? "destroy" : "solve");
     odhs_solver *s = odhs__calloc(1, sizeof *s);
-    if (!s) return ODHS_E_NOMEM;
+    if (!s) return odhs__create_err(ODHS_E_NOMEM, "odhs_solver_create: out of memory");
     s->type = type;
     s->check_tol = 1e-6;
     s->refine = 3;
     int st = type->create(&s->state);
     if (st) {
         odhs__free(s);
-        return st < 0 ? st : ODHS_E_INTERNAL;
+        return odhs__create_err(st < 0 ? st : ODHS_E_INTERNAL, "odhs_solver_create: %s's create returned %d",
+                                type->name, st);
     }
     *out = s;
     return ODHS_OK;
 }
 
+int odhs_solver_create(const odhs_solver_type *type, odhs_solver **out)
+{
+    odhs__create_begin();
+    return odhs__create_end(solver_create_impl(type, out));
+}
+
+/* the built-in solvers by name, in the order odhs_solver_list gives them */
+static const struct {
+    const char *name;
+    const odhs_solver_type *type; /* NULL: not built into this library */
+} builtin[] = {
+    {"auto", &odhs_solver_type_auto}, /* lib/solvers/auto.c */
+    {"cholmod",
+#ifdef ODHS_HAVE_SUITESPARSE
+     &odhs_solver_type_cholmod
+#else
+     NULL
+#endif
+    },
+    {"cholmod-pcg",
+#ifdef ODHS_HAVE_SUITESPARSE
+     &odhs_solver_type_cholmod_pcg
+#else
+     NULL
+#endif
+    },
+    {"spqr",
+#ifdef ODHS_HAVE_SUITESPARSE
+     &odhs_solver_type_spqr
+#else
+     NULL
+#endif
+    },
+    {"cg", &odhs_solver_type_cg},
+    {"dense", &odhs_solver_type_dense},
+};
+#define NBUILTIN (sizeof builtin / sizeof builtin[0])
+
+int odhs_solver_list(size_t k, const char **name, int *installed)
+{
+    if (!name) return ODHS_E_NULL;
+    *name = NULL;
+    if (k >= NBUILTIN) return ODHS_E_RANGE;
+    *name = builtin[k].name;
+    if (installed) *installed = builtin[k].type != NULL;
+    return ODHS_OK;
+}
+
+static int solver_create_by_name_impl(const char *name, odhs_solver **out)
+{
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_solver_create_by_name: out is NULL");
+    *out = NULL;
+    if (!name) return odhs__create_err(ODHS_E_NULL, "odhs_solver_create_by_name: name is NULL");
+    char known[128] = "";
+    size_t used = 0;
+    for (size_t k = 0; k < NBUILTIN; ++k) {
+        if (!strcmp(name, builtin[k].name)) {
+            if (!builtin[k].type)
+                return odhs__create_err(ODHS_E_NOTINSTALLED,
+                                        "odhs_solver_create_by_name: \"%s\" is not built into this library (built "
+                                        "without SuiteSparse; rebuild with SUITESPARSE=1)",
+                                        name);
+            return solver_create_impl(builtin[k].type, out);
+        }
+        if (builtin[k].type && used < sizeof known) {
+            int w = snprintf(known + used, sizeof known - used, "%s%s", used ? ", " : "", builtin[k].name);
+            if (w > 0) used += (size_t)w;
+        }
+    }
+    return odhs__create_err(ODHS_E_INVALID,
+                            "odhs_solver_create_by_name: unknown solver \"%.64s\" (names are case-sensitive; this "
+                            "library has: %s)",
+                            name, known);
+}
+
 int odhs_solver_create_by_name(const char *name, odhs_solver **out)
 {
-    if (!out) return ODHS_E_NULL;
-    *out = NULL;
-    if (!name) return ODHS_E_NULL;
-    if (!strcmp(name, "cg")) return odhs_solver_create(&odhs_solver_type_cg, out);
-    if (!strcmp(name, "dense")) return odhs_solver_create(&odhs_solver_type_dense, out);
-    if (!strcmp(name, "auto")) return odhs_solver_create(&odhs_solver_type_auto, out); /* lib/solvers/auto.c */
-#ifdef ODHS_HAVE_SUITESPARSE
-    if (!strcmp(name, "spqr")) return odhs_solver_create(&odhs_solver_type_spqr, out);
-    if (!strcmp(name, "cholmod")) return odhs_solver_create(&odhs_solver_type_cholmod, out);
-    if (!strcmp(name, "cholmod-pcg")) return odhs_solver_create(&odhs_solver_type_cholmod_pcg, out);
-#endif
-    if (!strcmp(name, "cholmod") || !strcmp(name, "spqr") || !strcmp(name, "cholmod-pcg"))
-        return ODHS_E_NOTINSTALLED;
-    return ODHS_E_INVALID;
+    odhs__create_begin();
+    return odhs__create_end(solver_create_by_name_impl(name, out));
 }
 
 void odhs_solver_destroy(odhs_solver *s)
@@ -70,6 +139,7 @@ const char *odhs_solver_name(const odhs_solver *s) { return s ? s->type->name : 
 int odhs_solver_set_param(odhs_solver *s, const char *key, double value)
 {
     if (!s) return ODHS_E_NULL;
+    s->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!key) return solerr(s, ODHS_E_NULL, "parameter name is NULL");
     if (!isfinite(value)) return solerr(s, ODHS_E_NONFINITE, "parameter %s is not finite", key);
     if (!s->type->set_param) return solerr(s, ODHS_E_INVALID, "backend %s has no parameters", s->type->name);
@@ -113,6 +183,7 @@ int odhs_solver_get_stat(const odhs_solver *s, const char *key, double *value)
 int odhs_solver_set_refinement(odhs_solver *s, int steps)
 {
     if (!s) return ODHS_E_NULL;
+    s->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (steps < 0 || steps > 100) return solerr(s, ODHS_E_INVALID, "refinement steps must be in [0, 100]");
     s->refine = steps;
     return ODHS_OK;
@@ -121,6 +192,7 @@ int odhs_solver_set_refinement(odhs_solver *s, int steps)
 int odhs_solver_set_check_tolerance(odhs_solver *s, double tol)
 {
     if (!s) return ODHS_E_NULL;
+    s->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(tol) || !(tol > 0.0)) return solerr(s, ODHS_E_INVALID, "check tolerance must be > 0");
     s->check_tol = tol;
     return ODHS_OK;
@@ -315,6 +387,7 @@ static int solve_one(odhs_solver *s, const odhs_network *net, const double *b, c
 int odhs_solver_set_fallback(odhs_solver *s, odhs_solver *fallback)
 {
     if (!s) return ODHS_E_NULL;
+    s->errmsg[0] = '\0'; /* a successful call leaves no message */
     for (const odhs_solver *f = fallback; f; f = f->fallback)
         if (f == s) return solerr(s, ODHS_E_INVALID, "fallback would form a cycle back to %s", s->type->name);
     s->fallback = fallback;

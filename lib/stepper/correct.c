@@ -184,5 +184,9 @@ int odhs__st_correct(odhs_stepper *st, int *added)
         int b = put_back(st, &o, SIZE_MAX, SIZE_MAX);
         if (!s) s = b;
     }
+    /* a force callback sees the corrected positions (since 0.2.7): the
+     * forces then belong to the state the observables and a checkpoint
+     * describe, so a restored run re-evaluates the same forces */
+    if (!s && st->drv->fn) s = odhs__st_external_forces(st);
     return s;
 }

@@ -59,6 +59,19 @@ int odhs__st_external_forces(odhs_stepper *st)
     if ((d->prop_on || d->grav_on) && odhs__driver_extra_forces(d, st->sys, st->F, &st->has_F))
         return odhs__sterr(st, ODHS_E_DIM, "self-propulsion or gravity settings do not fit N = %zu, d = %d", st->n,
                      st->dim);
+    if (st->has_F) {
+        /* velocities xi0 F are squared throughout (collision prediction,
+         * error estimates, skins): keep them where squares neither over-
+         * nor underflow */
+        double fm = 0.0;
+        for (size_t k = 0; k < st->nd; ++k) fm = fmax(fm, fabs(st->F[k]));
+        double v = d->xi0 * fm;
+        if (v > ODHS_VMAX || (v > 0.0 && v < ODHS_VMIN && !(odhs__flow_rate_scale(d) > 0.0)))
+            return odhs__sterr(st, d->fn ? ODHS_E_CALLBACK : ODHS_E_INVALID,
+                               "external forces up to %g (xi0 %g): velocities outside [%g, %g], where their squares "
+                               "over- or underflow; change the units (e.g. forces in units of their rms)",
+                               fm, d->xi0, ODHS_VMIN, ODHS_VMAX);
+    }
     return ODHS_OK;
 }
 

@@ -16,14 +16,19 @@ int odhs__sterr(const odhs_stepper *st, int status, const char *fmt, ...)
 }
 
 /* ---- lifecycle ------------------------------------------------------------- */
-int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver, odhs_stepper **out)
+static int stepper_create_impl(odhs_system *sys, odhs_driver *drv, odhs_solver *solver, odhs_stepper **out)
 {
-    if (!out) return ODHS_E_NULL;
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_stepper_create: out is NULL");
     *out = NULL;
-    if (!sys || !drv || !solver) return ODHS_E_NULL;
-    if (!sys->has_r || !sys->has_x) return odhs__syserr(sys, ODHS_E_STATE, "set radii and positions first");
+    if (!sys || !drv || !solver)
+        return odhs__create_err(ODHS_E_NULL, "odhs_stepper_create: the %s is NULL", !sys ? "system" : !drv ? "driver" : "solver");
+    if (!sys->has_r || !sys->has_x) {
+        odhs__syserr(sys, ODHS_E_STATE, "set radii and positions first");
+        return odhs__create_err(ODHS_E_STATE, "odhs_stepper_create: the system has no %s: set radii and positions first",
+                   !sys->has_r && !sys->has_x ? "radii and positions" : !sys->has_r ? "radii" : "positions");
+    }
     odhs_stepper *st = odhs__calloc(1, sizeof *st);
-    if (!st) return ODHS_E_NOMEM;
+    if (!st) return odhs__create_err(ODHS_E_NOMEM, "odhs_stepper_create: out of memory");
     st->sys = sys;
     st->drv = drv;
     st->sol = solver;
@@ -36,6 +41,7 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     st->h = st->dt;
     st->corr_every = odhs__step_heun.corr_default;
     st->contact_tol = 1e-9;
+    st->stall_steps = ODHS_STALL_STEPS_DEFAULT;
     st->iso_ci = st->iso_cj = SIZE_MAX;
     st->F = odhs__calloc(st->nd, sizeof(double));
     st->U = odhs__calloc(st->nd, sizeof(double));
@@ -53,10 +59,16 @@ int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver,
     int s = odhs_network_create(sys, &st->net);
     if (!st->F || !st->U || !st->tmp || !st->disp || !st->xs || !st->U0 || !st->Ua || !st->Up || !st->disps || s) {
         odhs_stepper_destroy(st);
-        return ODHS_E_NOMEM;
+        return odhs__create_err(ODHS_E_NOMEM, "odhs_stepper_create: out of memory (N = %zu)", sys->n);
     }
     *out = st;
     return ODHS_OK;
+}
+
+int odhs_stepper_create(odhs_system *sys, odhs_driver *drv, odhs_solver *solver, odhs_stepper **out)
+{
+    odhs__create_begin();
+    return odhs__create_end(stepper_create_impl(sys, drv, solver, out));
 }
 
 void odhs_stepper_destroy(odhs_stepper *st)
@@ -77,6 +89,7 @@ const char *odhs_stepper_errmsg(const odhs_stepper *st) { return st ? st->errmsg
 int odhs_stepper_set_dt(odhs_stepper *st, double dt)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(dt)) return odhs__sterr(st, ODHS_E_NONFINITE, "dt is not finite");
     if (!(dt > 0.0)) return odhs__sterr(st, ODHS_E_INVALID, "dt = %g must be > 0", dt);
     st->dt = dt;
@@ -87,6 +100,7 @@ int odhs_stepper_set_dt(odhs_stepper *st, double dt)
 int odhs_stepper_set_integrator(odhs_stepper *st, int integrator)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     const odhs__step_type *type = odhs__step_type_find(integrator);
     if (!type) return odhs__sterr(st, ODHS_E_INVALID, "unknown integrator %d", integrator);
     st->integrator = integrator;
@@ -98,6 +112,7 @@ int odhs_stepper_set_integrator(odhs_stepper *st, int integrator)
 int odhs_stepper_set_tolerance(odhs_stepper *st, double tol)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(tol) || !(tol > 0.0) || !(tol < 1.0))
         return odhs__sterr(st, ODHS_E_INVALID, "tolerance %g must be in (0, 1)", tol);
     st->tol = tol;
@@ -125,6 +140,7 @@ int odhs_stepper_rewire_stats(const odhs_stepper *st, uint64_t *count)
 int odhs__stepper_set_rewire_mode(odhs_stepper *st, int mode)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (mode != 0 && mode != 1) return odhs__sterr(st, ODHS_E_INVALID, "rewire mode %d is not 0 or 1", mode);
     st->rewire_mode = mode;
     return ODHS_OK;
@@ -141,6 +157,7 @@ int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejected, doub
 int odhs_stepper_set_correction_interval(odhs_stepper *st, unsigned k)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     st->corr_every = k;
     st->corr_user = 1;
     return ODHS_OK;
@@ -149,6 +166,7 @@ int odhs_stepper_set_correction_interval(odhs_stepper *st, unsigned k)
 int odhs_stepper_set_contact_tolerance(odhs_stepper *st, double tol)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(tol) || tol < 0.0 || tol > 0.1)
         return odhs__sterr(st, ODHS_E_INVALID, "contact tolerance %g must be in [0, 0.1]", tol);
     st->contact_tol = tol;
@@ -158,20 +176,57 @@ int odhs_stepper_set_contact_tolerance(odhs_stepper *st, double tol)
 int odhs_stepper_set_event_callback(odhs_stepper *st, odhs_event_fn fn, void *ctx)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     st->evfn = fn;
     st->evctx = ctx;
     return ODHS_OK;
 }
 
+int odhs_stepper_set_run_limits(odhs_stepper *st, uint64_t max_steps, uint64_t stall_steps)
+{
+    if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
+    st->max_steps = max_steps;
+    st->stall_steps = stall_steps;
+    return ODHS_OK;
+}
+
+int odhs_stepper_get_run_limits(const odhs_stepper *st, uint64_t *max_steps, uint64_t *stall_steps)
+{
+    if (!st) return ODHS_E_NULL;
+    if (max_steps) *max_steps = st->max_steps;
+    if (stall_steps) *stall_steps = st->stall_steps;
+    return ODHS_OK;
+}
+
+/* the handles behind the stepper are as its state expects: the force
+ * callback of a checkpointed run is set again, the system was not changed
+ * by its setters since the stepper last saw it */
+int odhs__st_check_handles(odhs_stepper *st)
+{
+    if (st->drv->fn_missing)
+        return odhs__sterr(st, ODHS_E_STATE,
+                           "the checkpointed run had a force callback: set it again on the restored driver "
+                           "(odhs_driver_set_force_callback; or odhs_driver_set_forces) before stepping");
+    if (st->ready && st->sys->version != st->sys_version)
+        return odhs__sterr(st, ODHS_E_STATE,
+                           "the system was changed behind the stepper's back (its setters were called since the "
+                           "last step): call odhs_stepper_reset to start from the changed system");
+    return ODHS_OK;
+}
+
 int odhs__st_check_driver(odhs_stepper *st)
 {
-    return odhs__driver_check(st->drv, st->n, st->dim, st->net->nwalls, st->errmsg);
+    int s = odhs__driver_check(st->drv, st->n, st->dim, st->net->nwalls, st->errmsg);
+    return s ? s : odhs__driver_check_rates(st->drv, st->sys, st->errmsg);
 }
 
 int odhs_stepper_reset(odhs_stepper *st)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     int s, psaved = 0;
+    if (st->drv->fn_missing) return odhs__st_check_handles(st);
     st->ready = 0;
     st->jammed = 0;
     odhs__solver_invalidate(st->sol); /* our network may reuse a freed address */
@@ -204,6 +259,7 @@ int odhs_stepper_reset(odhs_stepper *st)
     if ((s = odhs__st_rewire(st))) goto fail;
     st->nchg = 0;
     st->drv_version = st->drv->version;
+    st->sys_version = st->sys->version;
     st->ready = 1;
     return ODHS_OK;
 fail:

@@ -217,3 +217,23 @@ int odhs_stepper_errors(const odhs_stepper *st, double *contact_gap, double *ove
     }
     return ODHS_OK;
 }
+
+int odhs_stepper_contacts(const odhs_stepper *st, size_t cap, size_t *nc, size_t *i, size_t *j, int *kind, double *f,
+                          double *gap)
+{
+    if (!st) return ODHS_E_NULL;
+    if (!nc) return odhs__sterr(st, ODHS_E_NULL, "nc pointer is NULL");
+    if (!st->ready) return odhs__sterr(st, ODHS_E_STATE, "no contact network yet: reset or step first");
+    const odhs_network *net = st->net;
+    *nc = net->nc;
+    if (cap < net->nc)
+        return odhs__sterr(st, ODHS_E_RANGE, "room for %zu contacts, the network has %zu", cap, net->nc);
+    for (size_t k = 0; k < net->nc; ++k) {
+        if (i) i[k] = net->ci[k];
+        if (j) j[k] = net->cj[k];
+        if (kind) kind[k] = net->kind[k];
+        if (f) f[k] = net->f[k];
+        if (gap) gap[k] = net->gap[k];
+    }
+    return ODHS_OK;
+}

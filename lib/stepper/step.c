@@ -1,5 +1,6 @@
 /* libodhs - one step (Sect. IV A of the paper) and the run loops. */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -163,13 +164,18 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
         memset(first, 0, sizeof *first);
         first->kind = ODHS_EVENT_NONE;
     }
+    st->last_driver_only = 0;
+    if ((s = odhs__st_check_handles(st))) return s;
     if (!st->ready && (s = odhs_stepper_reset(st))) return s;
     if (st->jammed) return odhs__sterr(st, ODHS_JAMMED, "the packing is jammed: no further steps under this driving");
     if ((s = odhs__st_save(st))) return s;
     step_undo u = {st->drv_version, st->nrejected, st->tau, st->h, 0};
     st->nchg = 0;
     if ((s = driver_update(st, &u, first, stop, &done))) return undo(st, &u, s);
-    if (done) return ODHS_OK;
+    if (done) {
+        st->last_driver_only = 1;
+        return ODHS_OK;
+    }
     /* the step starts from the forces and flow now, re-solved if the driver
      * changed: a step the scheme repeats shorter returns to them, a failed
      * step to the state before the call */
@@ -193,7 +199,9 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
 int odhs_stepper_correct(odhs_stepper *st)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     int s, stop = 0, added = 0;
+    if ((s = odhs__st_check_handles(st))) return s;
     if (!st->ready && (s = odhs_stepper_reset(st))) return s;
     if ((s = odhs__st_save(st))) return s;
     const int jammed0 = st->jammed;
@@ -213,27 +221,125 @@ fail:
 int odhs_stepper_step(odhs_stepper *st, odhs_event *ev)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     int stop = 0;
     int s = do_step(st, INFINITY, ev, &stop);
     if (s) return s;
+    st->errmsg[0] = '\0';
     return stop ? ODHS_STOPPED : ODHS_OK;
 }
 
-/* generic run loop: remaining() gives the time left to the target (<= 0: done) */
+/* the fields of odhs_step_info the caller's size must at least cover */
+#define STEP_INFO_MIN (offsetof(odhs_step_info, kind) + sizeof(int))
+
+int odhs_stepper_step_ex(odhs_stepper *st, odhs_step_info *info)
+{
+    if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
+    if (!info) return odhs__sterr(st, ODHS_E_NULL, "step info pointer is NULL");
+    size_t size = info->size;
+    if (size < STEP_INFO_MIN)
+        return odhs__sterr(st, ODHS_E_INVALID,
+                           "odhs_step_info.size = %zu: set it to sizeof(odhs_step_info) (at least %zu)", size,
+                           (size_t)STEP_INFO_MIN);
+    odhs_step_info r;
+    memset(&r, 0, sizeof r);
+    odhs_event first;
+    const double t0 = st->time, g0 = st->strain;
+    const uint64_t c0 = st->ncoll, o0 = st->nopen;
+    int stop = 0;
+    int s = do_step(st, INFINITY, &first, &stop);
+    if (s < 0) return s;
+    r.size = size;
+    r.kind = first.kind;
+    r.i = first.i;
+    r.j = first.j;
+    r.event_time = first.time;
+    r.event_strain = first.strain;
+    r.collisions = st->ncoll - c0;
+    r.openings = st->nopen - o0;
+    r.time_start = t0;
+    r.time_end = st->time;
+    r.strain_start = g0;
+    r.strain_end = st->strain;
+    r.advanced = st->time != t0;
+    r.driver_change = st->last_driver_only;
+    /* only the bytes the caller's struct has: an older caller's smaller
+     * struct is filled up to its size, a newer caller's tail left alone */
+    memcpy(info, &r, size < sizeof r ? size : sizeof r);
+    if (s) return s; /* ODHS_JAMMED, ODHS_POTENTIALLY_JAMMED: the step was taken */
+    st->errmsg[0] = '\0';
+    return stop ? ODHS_STOPPED : ODHS_OK;
+}
+
+/* No event can ever happen: nothing in the scene changes with time (no
+ * flow, no pressure control, no callback, no self-propulsion) and every
+ * particle moves with the same velocity (or none, with walls): the
+ * configuration only translates, so no gap ever changes. */
+static int no_event_possible(const odhs_stepper *st)
+{
+    const odhs_driver *d = st->drv;
+    if (d->gdot != 0.0 || d->crate != 0.0 || d->pressure_on || d->osc_shape || d->fn || d->prop_on) return 0;
+    int dim = st->dim;
+    for (size_t i = 1; i < st->n; ++i)
+        for (int k = 0; k < dim; ++k)
+            if (st->U[i * dim + k] != st->U[k]) return 0;
+    if (st->net->nwalls)
+        for (int k = 0; k < dim; ++k)
+            if (st->U[k] != 0.0) return 0;
+    return 1;
+}
+
+/* generic run loop: remaining() gives the time left to the target (<= 0:
+ * done); max_events > 0 runs for that many events. Guards: the user's step
+ * cap (ODHS_STEP_LIMIT), a target too many steps away (ODHS_E_INVALID), no
+ * progress (ODHS_E_STALLED): stall_steps steps in a row that move neither
+ * the time, the strain nor the event count, or, for an event count, a scene
+ * in which no event can happen. */
 typedef double (*remaining_fn)(const odhs_stepper *st, const void *arg);
 
 static int run(odhs_stepper *st, remaining_fn rem, const void *arg, uint64_t max_events)
 {
-    uint64_t ev0 = st->ncoll + st->nopen;
+    int s;
+    if ((s = odhs__st_check_handles(st))) return s;
+    if (!st->ready && (s = odhs_stepper_reset(st))) return s;
+    uint64_t ev0 = st->ncoll + st->nopen, nstep = 0, stalled = 0;
+    if (rem) {
+        double left = rem(st, arg), big = 1e15 * st->dt * st->tau;
+        if (isfinite(left) && left > big)
+            return odhs__sterr(st, ODHS_E_INVALID,
+                               "the target is %g time units away, more than 1e15 of the largest steps (dt * tau = "
+                               "%g): raise dt or set a time unit (odhs_driver_set_time_unit)",
+                               left, st->dt * st->tau);
+    }
     for (;;) {
         double left = rem ? rem(st, arg) : INFINITY;
-        if (!(left > 0.0)) return ODHS_OK;
-        if (max_events && st->ncoll + st->nopen - ev0 >= max_events) return ODHS_OK;
+        if (!(left > 0.0)) break;
+        if (max_events && st->ncoll + st->nopen - ev0 >= max_events) break;
+        if (max_events && !st->jammed && no_event_possible(st))
+            return odhs__sterr(st, ODHS_E_STALLED,
+                               "no event can happen: no flow, no pressure control, forces that do not change with "
+                               "time, and every particle moving with the same velocity (%zu events of %llu taken)",
+                               (size_t)(st->ncoll + st->nopen - ev0), (unsigned long long)max_events);
+        if (st->max_steps && nstep >= st->max_steps)
+            return odhs__sterr(st, ODHS_STEP_LIMIT, "the run took its limit of %llu steps before its target",
+                               (unsigned long long)st->max_steps);
+        const double t0 = st->time, g0 = st->strain;
+        const uint64_t e0 = st->ncoll + st->nopen;
         int stop = 0;
-        int s = do_step(st, left, NULL, &stop);
+        s = do_step(st, left, NULL, &stop);
         if (s) return s;
+        nstep++;
+        if (st->time != t0 || st->strain != g0 || st->ncoll + st->nopen != e0) stalled = 0;
+        else if (st->stall_steps && ++stalled >= st->stall_steps)
+            return odhs__sterr(st, ODHS_E_STALLED,
+                               "no progress: %llu steps in a row moved neither the time (%.17g), the strain nor the "
+                               "event count; the step dt * tau = %g is below the resolution of the time",
+                               (unsigned long long)stalled, st->time, st->dt * st->tau);
         if (stop) return ODHS_STOPPED;
     }
+    st->errmsg[0] = '\0';
+    return ODHS_OK;
 }
 
 static double rem_time(const odhs_stepper *st, const void *arg)
@@ -246,6 +352,7 @@ static double rem_time(const odhs_stepper *st, const void *arg)
 int odhs_stepper_run_until_time(odhs_stepper *st, double t)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(t)) return odhs__sterr(st, ODHS_E_NONFINITE, "target time is not finite");
     return run(st, rem_time, &t, 0);
 }
@@ -258,6 +365,7 @@ static double rem_strain(const odhs_stepper *st, const void *arg)
 int odhs_stepper_run_until_strain(odhs_stepper *st, double gamma)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(gamma)) return odhs__sterr(st, ODHS_E_NONFINITE, "target strain is not finite");
     int s = odhs__flow_check_strain_target(st->drv, st->errmsg);
     if (s) return s;
@@ -267,6 +375,7 @@ int odhs_stepper_run_until_strain(odhs_stepper *st, double gamma)
 int odhs_stepper_run_events(odhs_stepper *st, uint64_t count)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (count == 0) return ODHS_OK;
     return run(st, NULL, NULL, count);
 }
@@ -285,6 +394,7 @@ static double rem_phi(const odhs_stepper *st, const void *arg)
 int odhs_stepper_run_until_packing_fraction(odhs_stepper *st, double phi)
 {
     if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(phi)) return odhs__sterr(st, ODHS_E_NONFINITE, "target packing fraction is not finite");
     if (!(phi > 0.0) || phi >= 1.0) return odhs__sterr(st, ODHS_E_INVALID, "packing fraction must be in (0,1)");
     if (st->drv->crate <= 0.0 && !st->drv->pressure_on)

@@ -113,6 +113,11 @@ struct odhs_stepper {
     /* events of the last step */
     odhs_event *ev;
     size_t nev, evcap;
+    int last_driver_only; /* the last step only applied a driver change (no motion) */
+    /* embedding safety (since 0.2.7) */
+    uint64_t sys_version;  /* the system's change count the state belongs to */
+    uint64_t max_steps;    /* steps one run call may take (0: no cap) */
+    uint64_t stall_steps;  /* steps without progress before ODHS_E_STALLED (0: never) */
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
@@ -249,5 +254,10 @@ int odhs__st_correct(odhs_stepper *st, int *added);
 int odhs__st_record_change(odhs_stepper *st, size_t i, size_t j, int delta);
 int odhs__st_emit_events(odhs_stepper *st, odhs_event *first, int *stop);
 int odhs__st_check_driver(odhs_stepper *st);
+/* the force callback of a checkpoint is set again and the system unchanged
+ * behind the stepper's back (ODHS_OK or ODHS_E_STATE with a message) */
+int odhs__st_check_handles(odhs_stepper *st);
+/* default of odhs_stepper_set_run_limits' stall_steps */
+#define ODHS_STALL_STEPS_DEFAULT 1000
 
 #endif /* ODHS_STEPPER_STEPPER_H */

@@ -21,13 +21,14 @@ int odhs__syserr(const odhs_system *sys, int status, const char *fmt, ...)
     return status;
 }
 
-int odhs_system_create(int dim, size_t n, odhs_system **out)
+static int system_create_impl(int dim, size_t n, odhs_system **out)
 {
-    if (!out) return ODHS_E_NULL;
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_system_create: out is NULL");
     *out = NULL;
-    if (dim != 2 && dim != 3) return ODHS_E_DIM;
-    if (n == 0) return ODHS_E_EMPTY;
-    if (n > SIZE_MAX / (3 * sizeof(double) + 32)) return ODHS_E_NOMEM;
+    if (dim != 2 && dim != 3) return odhs__create_err(ODHS_E_DIM, "odhs_system_create: dimension %d is not 2 or 3", dim);
+    if (n == 0) return odhs__create_err(ODHS_E_EMPTY, "odhs_system_create: N = 0 particles");
+    if (n > SIZE_MAX / (3 * sizeof(double) + 32))
+        return odhs__create_err(ODHS_E_NOMEM, "odhs_system_create: N = %zu is too large to allocate", n);
     odhs_system *s = odhs__calloc(1, sizeof *s);
     if (!s) return ODHS_E_NOMEM;
     s->dim = dim;
@@ -45,6 +46,12 @@ int odhs_system_create(int dim, size_t n, odhs_system **out)
     return ODHS_OK;
 }
 
+int odhs_system_create(int dim, size_t n, odhs_system **out)
+{
+    odhs__create_begin();
+    return odhs__create_end(system_create_impl(dim, n, out));
+}
+
 void odhs_system_destroy(odhs_system *sys)
 {
     if (!sys) return;
@@ -54,14 +61,14 @@ void odhs_system_destroy(odhs_system *sys)
     odhs__free(sys);
 }
 
-int odhs_system_clone(const odhs_system *sys, odhs_system **out)
+static int system_clone_impl(const odhs_system *sys, odhs_system **out)
 {
-    if (!out) return ODHS_E_NULL;
+    if (!out) return odhs__create_err(ODHS_E_NULL, "odhs_system_clone: out is NULL");
     *out = NULL;
-    if (!sys) return ODHS_E_NULL;
+    if (!sys) return odhs__create_err(ODHS_E_NULL, "odhs_system_clone: system is NULL");
     odhs_system *c;
     int st = odhs_system_create(sys->dim, sys->n, &c);
-    if (st) return odhs__syserr(sys, st, "clone: %s", odhs_strerror(st));
+    if (st) return odhs__create_err(st, "odhs_system_clone: %s", odhs_strerror(st));
     memcpy(c->L, sys->L, sizeof c->L);
     c->gamma = sys->gamma;
     memcpy(c->x, sys->x, sys->n * (size_t)sys->dim * sizeof(double));
@@ -74,7 +81,21 @@ int odhs_system_clone(const odhs_system *sys, odhs_system **out)
     return ODHS_OK;
 }
 
+int odhs_system_clone(const odhs_system *sys, odhs_system **out)
+{
+    odhs__create_begin();
+    return odhs__create_end(system_clone_impl(sys, out));
+}
+
 const char *odhs_system_errmsg(const odhs_system *sys) { return sys ? sys->errmsg : ""; }
+
+int odhs_system_change_count(const odhs_system *sys, uint64_t *count)
+{
+    if (!sys) return ODHS_E_NULL;
+    if (!count) return odhs__syserr(sys, ODHS_E_NULL, "output pointer is NULL");
+    *count = sys->version;
+    return ODHS_OK;
+}
 int odhs_system_dim(const odhs_system *sys) { return sys ? sys->dim : 0; }
 size_t odhs_system_count(const odhs_system *sys) { return sys ? sys->n : 0; }
 int odhs_system_is_ready(const odhs_system *sys) { return sys && sys->has_x && sys->has_r; }
@@ -186,6 +207,12 @@ static int commit(odhs_system *sys, const double *L, double gamma, double *r, in
         for (size_t i = 0; i < sys->n; ++i) odhs__wrap(sys->dim, L, gamma, x + i * sys->dim);
     }
     if (has_r && has_x && (st = check_overlaps(sys, L, gamma, r, rmax, x, -1.0))) return st;
+    /* the change counter counts changes: writing the values it holds is none */
+    size_t nd = sys->n * (size_t)sys->dim;
+    if (memcmp(sys->L, L, (size_t)sys->dim * sizeof(double)) || memcmp(&sys->gamma, &gamma, sizeof gamma) ||
+        has_r != sys->has_r || has_x != sys->has_x || (r != sys->r && memcmp(sys->r, r, sys->n * sizeof(double))) ||
+        (x != sys->x && memcmp(sys->x, x, nd * sizeof(double))))
+        sys->version++;
     memcpy(sys->L, L, (size_t)sys->dim * sizeof(double));
     sys->gamma = gamma;
     if (r != sys->r) memcpy(sys->r, r, sys->n * sizeof(double));
@@ -220,6 +247,7 @@ static int commit_copy(odhs_system *sys, const double *L, double gamma, const do
 int odhs_system_set_box(odhs_system *sys, const double *L)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!L) return odhs__syserr(sys, ODHS_E_NULL, "box lengths pointer is NULL");
     double LL[3] = {sys->L[0], sys->L[1], sys->L[2]};
     memcpy(LL, L, (size_t)sys->dim * sizeof(double));
@@ -245,6 +273,7 @@ int odhs_system_volume(const odhs_system *sys, double *vol)
 int odhs_system_set_strain(odhs_system *sys, double gamma)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     return commit_copy(sys, sys->L, gamma, sys->r, sys->has_r, sys->x, sys->has_x);
 }
 
@@ -259,6 +288,7 @@ int odhs_system_get_strain(const odhs_system *sys, double *gamma)
 int odhs_system_set_radii(odhs_system *sys, const double *r)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!r) return odhs__syserr(sys, ODHS_E_NULL, "radii pointer is NULL");
     return commit_copy(sys, sys->L, sys->gamma, r, 1, sys->x, sys->has_x);
 }
@@ -275,6 +305,7 @@ int odhs_system_get_radii(const odhs_system *sys, double *r)
 int odhs_system_set_positions(odhs_system *sys, const double *x)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!x) return odhs__syserr(sys, ODHS_E_NULL, "positions pointer is NULL");
     return commit_copy(sys, sys->L, sys->gamma, sys->r, sys->has_r, x, 1);
 }
@@ -292,6 +323,7 @@ int odhs_system_set_configuration(odhs_system *sys, const double *L, double gamm
                                   const double *x)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!L || !r || !x) return odhs__syserr(sys, ODHS_E_NULL, "a configuration pointer is NULL");
     double LL[3] = {1.0, 1.0, 1.0};
     memcpy(LL, L, (size_t)sys->dim * sizeof(double));
@@ -312,6 +344,7 @@ static int valid_label(const char *s)
 int odhs_system_set_species(odhs_system *sys, size_t i, const char *label)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!label) return odhs__syserr(sys, ODHS_E_NULL, "label is NULL");
     if (i >= sys->n) return odhs__syserr(sys, ODHS_E_RANGE, "particle index %zu >= N = %zu", i, sys->n);
     if (!valid_label(label))
@@ -336,6 +369,7 @@ int odhs_system_get_species(const odhs_system *sys, size_t i, char *buf, size_t 
 int odhs_system_scale_box(odhs_system *sys, double s)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(s)) return odhs__syserr(sys, ODHS_E_NONFINITE, "scale factor is not finite");
     if (!(s > 0.0)) return odhs__syserr(sys, ODHS_E_INVALID, "scale factor %g is not positive", s);
     size_t nd = sys->n * (size_t)sys->dim;
@@ -424,6 +458,7 @@ int odhs_system_set_radii_bidisperse(odhs_system *sys, double r_small, double ra
                                      uint64_t seed)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(r_small) || !isfinite(ratio) || !isfinite(poly))
         return odhs__syserr(sys, ODHS_E_NONFINITE, "bidisperse parameters must be finite");
     if (!(r_small > 0.0) || !(ratio > 0.0) || poly < 0.0 || poly >= 1.0)
@@ -602,6 +637,7 @@ static int rsa_place(odhs_system *sys, rsa_grid *g, const double *L, const size_
 int odhs_system_place_random(odhs_system *sys, double phi, uint64_t seed)
 {
     if (!sys) return ODHS_E_NULL;
+    sys->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (!isfinite(phi)) return odhs__syserr(sys, ODHS_E_NONFINITE, "packing fraction is not finite");
     if (!(phi > 0.0) || phi >= 1.0)
         return odhs__syserr(sys, ODHS_E_INVALID, "packing fraction %g must be in (0,1)", phi);

@@ -19,6 +19,7 @@ struct odhs_system {
     int has_x, has_r;
     double rmax;    /* largest radius (0 if unset) */
     double overlap_accept; /* relative overlap accepted by the setters (0: 1e-10) */
+    uint64_t version; /* changes through the public setters (odhs_system_change_count) */
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
