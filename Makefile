@@ -20,8 +20,8 @@
 #   examples        stage-install into build/stage, build examples/*.c (and
 #                   examples/mpi/sweep_mpi.c: sweep_serial, and sweep_mpi
 #                   when mpicc exists) against it with pkg-config only, run
-#                   pkgconfig-test; examples/lammps_coupling.c when LAMMPS's
-#                   C library interface is installed
+#                   pkgconfig-test; examples/lammps_coupling.c and its test
+#                   when LAMMPS's C library interface is installed
 #   pkgconfig-test  compile + run tests/pkgconfig_consumer.c, shared and static
 #   check-mpi       build examples/mpi/sweep_mpi.c with mpicc and run a tiny
 #                   campaign on 2 ranks, killed and resumed, against a serial
@@ -230,9 +230,10 @@ ifeq ($(HAVE_MPI),1)
 EXAMPLE_BINS += build/examples/sweep_mpi
 endif
 
-# LAMMPS coupling (examples/lammps_coupling.c): built only when LAMMPS's C
-# library interface is there: its pkg-config file and header (Debian
-# liblammps-dev: liblammps.pc, /usr/include/lammps/library.h).
+# LAMMPS coupling (examples/lammps_coupling.c): built, and tested by
+# tests/lammps_coupling.sh, only when LAMMPS's C library interface is there:
+# its pkg-config file and header (Debian liblammps-dev: liblammps.pc,
+# /usr/include/lammps/library.h).
 LAMMPS_PC   ?= liblammps
 HAVE_LAMMPS := $(if $(wildcard $(shell $(PKG_CONFIG) --variable=includedir $(LAMMPS_PC) 2>/dev/null)/lammps/library.h),1,0)
 EXAMPLE_BINS := $(filter-out build/examples/lammps_coupling,$(EXAMPLE_BINS))
@@ -446,6 +447,9 @@ examples: stage
 	@$(MAKE) --no-print-directory examples-build pkgconfig-test-run
 	bash tests/docs_samples.sh build/stage
 	bash tests/examples_cli.sh build/examples
+ifeq ($(HAVE_LAMMPS),1)
+	bash tests/lammps_coupling.sh build/examples
+endif
 
 examples-build: $(EXAMPLE_BINS)
 	@echo "examples: $(if $(EXAMPLE_BINS),built $(EXAMPLE_BINS),none in examples/)"
