@@ -20,7 +20,8 @@
 #   examples        stage-install into build/stage, build examples/*.c (and
 #                   examples/mpi/sweep_mpi.c: sweep_serial, and sweep_mpi
 #                   when mpicc exists) against it with pkg-config only, run
-#                   pkgconfig-test
+#                   pkgconfig-test; examples/lammps_coupling.c and its test
+#                   when LAMMPS's C library interface is installed
 #   pkgconfig-test  compile + run tests/pkgconfig_consumer.c, shared and static
 #   check-mpi       build examples/mpi/sweep_mpi.c with mpicc and run a tiny
 #                   campaign on 2 ranks, killed and resumed, against a serial
@@ -229,6 +230,17 @@ ifeq ($(HAVE_MPI),1)
 EXAMPLE_BINS += build/examples/sweep_mpi
 endif
 
+# LAMMPS coupling (examples/lammps_coupling.c): built, and tested by
+# tests/lammps_coupling.sh, only when LAMMPS's C library interface is there:
+# its pkg-config file and header (Debian liblammps-dev: liblammps.pc,
+# /usr/include/lammps/library.h).
+LAMMPS_PC   ?= liblammps
+HAVE_LAMMPS := $(if $(wildcard $(shell $(PKG_CONFIG) --variable=includedir $(LAMMPS_PC) 2>/dev/null)/lammps/library.h),1,0)
+EXAMPLE_BINS := $(filter-out build/examples/lammps_coupling,$(EXAMPLE_BINS))
+ifeq ($(HAVE_LAMMPS),1)
+EXAMPLE_BINS += build/examples/lammps_coupling
+endif
+
 PCTEST_DIR    := build/pkgconfig-test
 PCTEST_SHARED := $(PCTEST_DIR)/consumer-shared
 PCTEST_STATIC := $(PCTEST_DIR)/consumer-static
@@ -435,9 +447,15 @@ examples: stage
 	@$(MAKE) --no-print-directory examples-build pkgconfig-test-run
 	bash tests/docs_samples.sh build/stage
 	bash tests/examples_cli.sh build/examples
+ifeq ($(HAVE_LAMMPS),1)
+	bash tests/lammps_coupling.sh build/examples
+endif
 
 examples-build: $(EXAMPLE_BINS)
 	@echo "examples: $(if $(EXAMPLE_BINS),built $(EXAMPLE_BINS),none in examples/)"
+ifneq ($(HAVE_LAMMPS),1)
+	@echo "lammps_coupling: SKIPPED: no LAMMPS C library interface ($(LAMMPS_PC).pc and lammps/library.h; apt-get install liblammps-dev, or make deps)"
+endif
 
 # Only pkg-config output (plus an rpath to the stage) - no -Iinclude here.
 # -lm is the examples' own need (they call floor, ceil, ...), not libodhs's.
@@ -445,6 +463,12 @@ build/examples/%: examples/%.c examples/cli.h examples/plot.h $(STAGE_LIBDIR)/li
 	@mkdir -p $(@D)
 	$(CC) $(CONSUMER_CFLAGS) -o $@ $< \
 	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) -lm $(STAGE_RPATH)
+
+# the odhs flags from the stage, LAMMPS's from its own pkg-config file
+build/examples/lammps_coupling: examples/lammps_coupling.c examples/cli.h examples/plot.h $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
+	@mkdir -p $(@D)
+	$(CC) $(CONSUMER_CFLAGS) -o $@ $< \
+	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) $$($(PKG_CONFIG) --cflags --libs $(LAMMPS_PC)) -lm $(STAGE_RPATH)
 
 build/examples/sweep_serial: $(SWEEP_SRC) examples/cli.h $(STAGE_LIBDIR)/libodhs.so.$(VERSION) $(STAGE_PC_PATH)/odhs.pc
 	@mkdir -p $(@D)
@@ -604,11 +628,13 @@ fuzz-ci: fuzz
 # openmpi-bin and libopenmpi-dev (mpicc, mpirun): sweep_mpi and make check-mpi.
 # lammps (lmp), python3-ase, python3-numpy: tests/examples_cli.sh reads the
 # examples' files with LAMMPS, ASE and numpy (skipped with a message without them).
+# liblammps-dev (LAMMPS's C library interface): examples/lammps_coupling.c.
 DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
                  check pkg-config gcc make \
                  clang libclang-rt-14-dev \
                  openmpi-bin libopenmpi-dev \
-                 lammps python3-ase python3-numpy
+                 lammps python3-ase python3-numpy \
+                 liblammps-dev
 
 deps:
 	@if [ "$$(id -u)" -eq 0 ]; then SUDO=; else SUDO=sudo; fi; \
