@@ -22,6 +22,8 @@
 #                   when mpicc exists) against it with pkg-config only, run
 #                   pkgconfig-test
 #   pkgconfig-test  compile + run tests/pkgconfig_consumer.c, shared and static
+#   print-libs      the libraries to link lib/libodhs.a with (system libraries
+#                   shared): gcc ... lib/libodhs.a $(make -s print-libs)
 #   check-mpi       build examples/mpi/sweep_mpi.c with mpicc and run a tiny
 #                   campaign on 2 ranks, killed and resumed, against a serial
 #                   run (skipped when MPI is absent)
@@ -121,9 +123,59 @@ endif
 # LAPACKE/LAPACK/BLAS are always required.
 MATH_LIBS := -llapacke -llapack -lblas -lm
 
-# Everything the library itself links against (also Libs.private in odhs.pc).
+# Everything the library itself links against, the system libraries being
+# shared (`make print-libs` prints it for linking lib/libodhs.a).
 ODHS_LIBS    := $(SUITESPARSE_LIBS) $(MATH_LIBS)
-LIBS_PRIVATE := $(strip $(ODHS_LIBS))
+
+# ---------------------------------------------------------------------------
+# odhs.pc's static-link fields, what `pkg-config --static --libs odhs` adds
+# after -lodhs: all a program linking libodhs.a needs, and with `cc -static`
+# the dependencies of the system's static libraries too.
+#  - Requires.private: those of lapacke, lapack, blas that have a .pc file
+#    (Debian has all three).
+#  - Libs.private: SuiteSparse 5.x has no .pc files, so its libraries are
+#    named here with the static dependencies of libcholmod.a (AMD, CAMD,
+#    COLAMD, CCOLAMD, METIS, OpenMP). Then the math libraries' -l flags once
+#    more (from `pkg-config --static --libs-only-l`, each kept at its last
+#    place) and -lquadmath after -lgfortran: a static libgfortran needs it,
+#    and pkg-config puts Requires.private after Libs.private, so only here
+#    can -lquadmath follow -lgfortran.
+#  - The optional libraries (PC_OPTIONAL_LIBS) are listed only when $(CC)
+#    finds them (as .so or .a): a library that the shared system libraries
+#    load themselves (libmetis.so.5) may lack its development link. Those not
+#    found are named in odhs.pc's variable static_missing (a fully static
+#    link then fails; tests/link_check.sh skips it, naming them).
+# Looked up once, when first used (by the odhs.pc rule and print-*), so that
+# `make clean` or `make deps` need neither pkg-config nor the libraries.
+# ---------------------------------------------------------------------------
+PC_MATH_MODULES := lapacke lapack blas
+PC_SUITESPARSE_STATIC := -lspqr -lcholmod -lccolamd -lcamd -lcolamd -lamd -lmetis \
+                         -lsuitesparseconfig -lgomp
+PC_OPTIONAL_LIBS := ccolamd camd colamd amd metis gomp quadmath
+
+# $(call pc_has,module): non-empty when pkg-config knows the module
+pc_has = $(shell $(PKG_CONFIG) --exists $(1) 2>/dev/null && echo yes)
+# $(call cc_finds,name): non-empty when $(CC) finds libname.so or libname.a
+# (-print-file-name answers the bare name when it finds nothing)
+cc_finds = $(filter /%,$(shell $(CC) -print-file-name=lib$(1).so) $(shell $(CC) -print-file-name=lib$(1).a))
+# $(call uniq_last,words): each word once, at its last place
+uniq_last = $(if $(1),$(if $(filter $(firstword $(1)),$(wordlist 2,$(words $(1)),$(1))),,$(firstword $(1))) \
+            $(call uniq_last,$(wordlist 2,$(words $(1)),$(1))))
+
+PC_REQUIRES_PRIVATE_ = $(foreach m,$(PC_MATH_MODULES),$(if $(call pc_has,$(m)),$(m)))
+PC_MATH_STATIC_      = $(foreach m,$(PC_MATH_MODULES),$(if $(filter $(m),$(REQUIRES_PRIVATE)),$(shell \
+                           $(PKG_CONFIG) --static --libs-only-l $(m)),-l$(m))) -lm
+PC_STATIC_CANDIDATES_ = $(call uniq_last,$(if $(filter 1,$(HAVE_SUITESPARSE)),$(PC_SUITESPARSE_STATIC)) \
+                           $(PC_MATH_STATIC_) $(if $(filter -lgfortran,$(PC_MATH_STATIC_)),-lgfortran -lquadmath) \
+                           -lpthread -lm)
+PC_STATIC_MISSING_   = $(foreach l,$(filter $(PC_OPTIONAL_LIBS:%=-l%),$(PC_STATIC_CANDIDATES)), \
+                           $(if $(call cc_finds,$(l:-l%=%)),,$(l)))
+
+# The cached values (the $(eval) replaces each by its value on first use).
+PC_STATIC_CANDIDATES = $(eval PC_STATIC_CANDIDATES := $(strip $(PC_STATIC_CANDIDATES_)))$(PC_STATIC_CANDIDATES)
+REQUIRES_PRIVATE = $(eval REQUIRES_PRIVATE := $(strip $(PC_REQUIRES_PRIVATE_)))$(REQUIRES_PRIVATE)
+STATIC_MISSING   = $(eval STATIC_MISSING := $(strip $(PC_STATIC_MISSING_)))$(STATIC_MISSING)
+LIBS_PRIVATE     = $(eval LIBS_PRIVATE := $(filter-out $(STATIC_MISSING),$(PC_STATIC_CANDIDATES)))$(LIBS_PRIVATE)
 
 # ---------------------------------------------------------------------------
 # Compiler flags. ODHS_* are the fixed project flags; CFLAGS/CPPFLAGS/LDFLAGS
@@ -388,7 +440,9 @@ PC_FILE := $(BUILD)/odhs.pc
 # `pkg-config --define-prefix` can relocate an installed tree.
 pc_relative = $(patsubst $(PREFIX)/%,$${prefix}/%,$(1))
 
-# Regenerated whenever the substituted values change (PREFIX, SUITESPARSE...).
+# Regenerated whenever the substituted values change (PREFIX, SUITESPARSE...);
+# a Requires.private without modules (no lapacke.pc, lapack.pc, blas.pc) is
+# left out.
 $(PC_FILE): pkgconfig/odhs.pc.in FORCE
 	@mkdir -p $(@D)
 	@sed -e 's|@PREFIX@|$(PREFIX)|g' \
@@ -396,6 +450,9 @@ $(PC_FILE): pkgconfig/odhs.pc.in FORCE
 	     -e 's|@INCLUDEDIR@|$(call pc_relative,$(INCLUDEDIR))|g' \
 	     -e 's|@VERSION@|$(VERSION)|g' \
 	     -e 's|@LIBS_PRIVATE@|$(LIBS_PRIVATE)|g' \
+	     -e 's|@REQUIRES_PRIVATE@|$(REQUIRES_PRIVATE)|g' \
+	     -e 's|@STATIC_MISSING@|$(STATIC_MISSING)|g' \
+	     -e '/^Requires\.private: *$$/d' \
 	     $< > $@.tmp
 	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv -f $@.tmp $@; fi
 
@@ -471,7 +528,7 @@ endif
 pkgconfig-test: stage
 	@$(MAKE) --no-print-directory pkgconfig-test-run
 
-.PHONY: pkgconfig-test-run
+.PHONY: pkgconfig-test-run print-libs
 pkgconfig-test-run:
 	@mkdir -p $(PCTEST_DIR)
 	@echo "== pkg-config consumer, shared: $$($(STAGE_PKG_CONFIG) --cflags --libs odhs)"
@@ -490,6 +547,11 @@ pkgconfig-test-run:
 	@! readelf -d $(PCTEST_STATIC) | grep -q 'NEEDED.*libodhs' || \
 	    { echo "pkgconfig-test: $(PCTEST_STATIC) still needs libodhs.so"; exit 1; }
 	@echo "pkgconfig-test: ok"
+
+# The libraries lib/libodhs.a needs, the system libraries being shared:
+#   gcc -std=c11 -Iinclude prog.c lib/libodhs.a $(make -s print-libs) -lm
+print-libs:
+	@echo '$(strip $(ODHS_LIBS))'
 
 demo:
 	@$(MAKE) --no-print-directory deps-if-missing
