@@ -2,7 +2,8 @@
 #
 # Main targets (`make help` prints this list):
 #   all (default)   lib/libodhs.a, lib/libodhs.so.X.Y.Z + soname/dev symlinks
-#   check           build and run the Check test runner, plus check-symbols
+#   check           build and run the Check test runner, plus check-symbols,
+#                   check-readme and check-link
 #   check-asan      rebuild library + tests in build-asan/ with ASan/UBSan, run
 #   check-allocfail rebuild in build-allocfail/ with allocation-failure
 #                   injection (-DODHS_FAULT_INJECTION) + ASan/UBSan/LSan and
@@ -15,13 +16,20 @@
 #                   fail on any crash; prints the number of executions
 #   check-symbols   fail if lib/libodhs.so exports anything not named odhs_*
 #   check-run       run the tests without deps-if-missing/check-symbols
+#   check-link      stage, then link tests/pkgconfig_consumer.c by every link
+#                   line of README.md and docs/guide.md and with pkg-config
+#                   (shared, static libodhs.a, fully static), run each
+#                   (tests/link_check.sh; a fully static link is skipped,
+#                   naming them, when static libraries are missing); in a
+#                   SuiteSparse build also against a SUITESPARSE=0 one
+#                   (build/link-nos), which links fully statically on Debian
 #   check-rheology  the rheology suite to strain 2 (fixed-pressure flow)
 #   tests           only build the runner build/tests/run_tests
 #   examples        stage-install into build/stage, build examples/*.c (and
 #                   examples/mpi/sweep_mpi.c: sweep_serial, and sweep_mpi
 #                   when mpicc exists) against it with pkg-config only, run
 #                   pkgconfig-test
-#   pkgconfig-test  compile + run tests/pkgconfig_consumer.c, shared and static
+#   pkgconfig-test  the same as check-link
 #   print-libs      the libraries to link lib/libodhs.a with (system libraries
 #                   shared): gcc ... lib/libodhs.a $(make -s print-libs)
 #   check-mpi       build examples/mpi/sweep_mpi.c with mpicc and run a tiny
@@ -281,10 +289,6 @@ ifeq ($(HAVE_MPI),1)
 EXAMPLE_BINS += build/examples/sweep_mpi
 endif
 
-PCTEST_DIR    := build/pkgconfig-test
-PCTEST_SHARED := $(PCTEST_DIR)/consumer-shared
-PCTEST_STATIC := $(PCTEST_DIR)/consumer-static
-
 BENCH_SRCS := $(sort $(wildcard bench/*.c))
 BENCH_BINS := $(BENCH_SRCS:bench/%.c=build/bench/%)
 
@@ -353,13 +357,13 @@ $(SHARED_DEVLINK): $(SHARED_SONAME)
 # ===========================================================================
 # Tests
 # ===========================================================================
-.PHONY: check check-run check-asan check-allocfail check-symbols check-readme tests
+.PHONY: check check-run check-asan check-allocfail check-symbols check-readme check-link tests
 
 # deps-if-missing runs first, then a fresh make instance does the work, so
 # that SUITESPARSE=auto and the pkg-config lookups see freshly installed
 # packages and `make -j check` cannot start compiling before apt-get is done.
 check: deps-if-missing
-	@$(MAKE) --no-print-directory check-symbols check-readme check-run
+	@$(MAKE) --no-print-directory check-symbols check-readme check-run check-link
 
 # Build the runner only.
 tests: $(TEST_RUNNER)
@@ -525,28 +529,41 @@ else
 	@echo "check-mpi: SKIPPED: no MPI ($(MPICC) and $(MPIRUN) not both found; Debian: apt-get install openmpi-bin libopenmpi-dev, or make deps)"
 endif
 
+# The stand-alone consumer linked by every link line of the documents and by
+# pkg-config: shared, static libodhs.a, fully static (tests/link_check.sh
+# says which, and skips a fully static link that lacks a static library).
+# In a SuiteSparse build, check-link-nos then does the same against a build
+# without it, whose fully static link needs only LAPACK, BLAS and gcc's own
+# libraries (all there as .a on Debian, unlike METIS).
+check-link: stage
+	@$(MAKE) --no-print-directory pkgconfig-test-run
+ifeq ($(HAVE_SUITESPARSE),1)
+	@$(MAKE) --no-print-directory check-link-nos
+endif
+
+# SUITESPARSE=0 in build/link-nos (objects, libraries), installed into
+# build/link-nos/stage; linked with the pkg-config lines only.
+LINK_NOS := build/link-nos
+.PHONY: check-link-nos
+check-link-nos:
+	@echo "== building and installing a SUITESPARSE=0 libodhs into $(LINK_NOS)/stage (log: $(LINK_NOS)/build.log)"
+	@mkdir -p $(LINK_NOS)
+	@$(MAKE) --no-print-directory install SUITESPARSE=0 BUILD=$(LINK_NOS) OUT_LIBDIR=$(LINK_NOS)/lib \
+	    DESTDIR= PREFIX=$(CURDIR)/$(LINK_NOS)/stage LIBDIR=$(CURDIR)/$(LINK_NOS)/stage/lib \
+	    INCLUDEDIR=$(CURDIR)/$(LINK_NOS)/stage/include PC_FILE=$(LINK_NOS)/stage-odhs.pc \
+	    > $(LINK_NOS)/build.log 2>&1 || { tail -n 30 $(LINK_NOS)/build.log; exit 1; }
+	@echo "== linking $(TEST_STANDALONE) against it with pkg-config"
+	@CC="$(CC)" LINK_CHECK_CFLAGS="$(CONSUMER_CFLAGS)" LINK_CHECK_DIR=$(LINK_NOS)/link-check \
+	    bash tests/link_check.sh $(LINK_NOS)/stage $(TEST_STANDALONE)
+
 pkgconfig-test: stage
 	@$(MAKE) --no-print-directory pkgconfig-test-run
 
 .PHONY: pkgconfig-test-run print-libs
 pkgconfig-test-run:
-	@mkdir -p $(PCTEST_DIR)
-	@echo "== pkg-config consumer, shared: $$($(STAGE_PKG_CONFIG) --cflags --libs odhs)"
-	$(CC) $(CONSUMER_CFLAGS) -o $(PCTEST_SHARED) $(TEST_STANDALONE) \
-	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) $(STAGE_RPATH)
-	./$(PCTEST_SHARED)
-	@readelf -d $(PCTEST_SHARED) | grep -q 'NEEDED.*\[$(SONAME)\]' || \
-	    { echo "pkgconfig-test: $(PCTEST_SHARED) does not need $(SONAME)"; exit 1; }
-	@# Static: link libodhs.a (-lodhs -> -l:libodhs.a, since the linker would
-	@# otherwise prefer the .so) with `pkg-config --static` Libs.private.
-	@echo "== pkg-config consumer, static: $$($(STAGE_PKG_CONFIG) --static --cflags --libs odhs)"
-	$(CC) $(CONSUMER_CFLAGS) -o $(PCTEST_STATIC) $(TEST_STANDALONE) \
-	    $$($(STAGE_PKG_CONFIG) --cflags odhs) \
-	    $$($(STAGE_PKG_CONFIG) --static --libs odhs | sed 's/\(^\|[[:space:]]\)-lodhs\([[:space:]]\|$$\)/\1-l:libodhs.a\2/')
-	./$(PCTEST_STATIC)
-	@! readelf -d $(PCTEST_STATIC) | grep -q 'NEEDED.*libodhs' || \
-	    { echo "pkgconfig-test: $(PCTEST_STATIC) still needs libodhs.so"; exit 1; }
-	@echo "pkgconfig-test: ok"
+	@echo "== linking $(TEST_STANDALONE): the link lines of README.md and docs/guide.md, pkg-config"
+	@CC="$(CC)" LINK_CHECK_CFLAGS="$(CONSUMER_CFLAGS)" LINK_CHECK_DIR=build/link-check \
+	    bash tests/link_check.sh $(STAGE) $(TEST_STANDALONE) README.md docs/guide.md
 
 # The libraries lib/libodhs.a needs, the system libraries being shared:
 #   gcc -std=c11 -Iinclude prog.c lib/libodhs.a $(make -s print-libs) -lm
