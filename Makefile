@@ -2,7 +2,8 @@
 #
 # Main targets (`make help` prints this list):
 #   all (default)   lib/libodhs.a, lib/libodhs.so.X.Y.Z + soname/dev symlinks
-#   check           build and run the Check test runner, plus check-symbols
+#   check           build and run the Check test runner, plus check-symbols,
+#                   check-readme and check-link
 #   check-asan      rebuild library + tests in build-asan/ with ASan/UBSan, run
 #   check-allocfail rebuild in build-allocfail/ with allocation-failure
 #                   injection (-DODHS_FAULT_INJECTION) + ASan/UBSan/LSan and
@@ -15,6 +16,13 @@
 #                   fail on any crash; prints the number of executions
 #   check-symbols   fail if lib/libodhs.so exports anything not named odhs_*
 #   check-run       run the tests without deps-if-missing/check-symbols
+#   check-link      stage, then link tests/pkgconfig_consumer.c by every link
+#                   line of README.md and docs/guide.md and with pkg-config
+#                   (shared, static libodhs.a, fully static), run each
+#                   (tests/link_check.sh; a fully static link is skipped,
+#                   naming them, when static libraries are missing); in a
+#                   SuiteSparse build also against a SUITESPARSE=0 one
+#                   (build/link-nos), which links fully statically on Debian
 #   check-rheology  the rheology suite to strain 2 (fixed-pressure flow)
 #   tests           only build the runner build/tests/run_tests
 #   examples        stage-install into build/stage, build examples/*.c (and
@@ -22,7 +30,9 @@
 #                   when mpicc exists) against it with pkg-config only, run
 #                   pkgconfig-test; examples/lammps_coupling.c and its test
 #                   when LAMMPS's C library interface is installed
-#   pkgconfig-test  compile + run tests/pkgconfig_consumer.c, shared and static
+#   pkgconfig-test  the same as check-link
+#   print-libs      the libraries to link lib/libodhs.a with (system libraries
+#                   shared): gcc ... lib/libodhs.a $(make -s print-libs)
 #   check-mpi       build examples/mpi/sweep_mpi.c with mpicc and run a tiny
 #                   campaign on 2 ranks, killed and resumed, against a serial
 #                   run (skipped when MPI is absent)
@@ -122,9 +132,59 @@ endif
 # LAPACKE/LAPACK/BLAS are always required.
 MATH_LIBS := -llapacke -llapack -lblas -lm
 
-# Everything the library itself links against (also Libs.private in odhs.pc).
+# Everything the library itself links against, the system libraries being
+# shared (`make print-libs` prints it for linking lib/libodhs.a).
 ODHS_LIBS    := $(SUITESPARSE_LIBS) $(MATH_LIBS)
-LIBS_PRIVATE := $(strip $(ODHS_LIBS))
+
+# ---------------------------------------------------------------------------
+# odhs.pc's static-link fields, what `pkg-config --static --libs odhs` adds
+# after -lodhs: all a program linking libodhs.a needs, and with `cc -static`
+# the dependencies of the system's static libraries too.
+#  - Requires.private: those of lapacke, lapack, blas that have a .pc file
+#    (Debian has all three).
+#  - Libs.private: SuiteSparse 5.x has no .pc files, so its libraries are
+#    named here with the static dependencies of libcholmod.a (AMD, CAMD,
+#    COLAMD, CCOLAMD, METIS, OpenMP). Then the math libraries' -l flags once
+#    more (from `pkg-config --static --libs-only-l`, each kept at its last
+#    place) and -lquadmath after -lgfortran: a static libgfortran needs it,
+#    and pkg-config puts Requires.private after Libs.private, so only here
+#    can -lquadmath follow -lgfortran.
+#  - The optional libraries (PC_OPTIONAL_LIBS) are listed only when $(CC)
+#    finds them (as .so or .a): a library that the shared system libraries
+#    load themselves (libmetis.so.5) may lack its development link. Those not
+#    found are named in odhs.pc's variable static_missing (a fully static
+#    link then fails; tests/link_check.sh skips it, naming them).
+# Looked up once, when first used (by the odhs.pc rule and print-*), so that
+# `make clean` or `make deps` need neither pkg-config nor the libraries.
+# ---------------------------------------------------------------------------
+PC_MATH_MODULES := lapacke lapack blas
+PC_SUITESPARSE_STATIC := -lspqr -lcholmod -lccolamd -lcamd -lcolamd -lamd -lmetis \
+                         -lsuitesparseconfig -lgomp
+PC_OPTIONAL_LIBS := ccolamd camd colamd amd metis gomp quadmath
+
+# $(call pc_has,module): non-empty when pkg-config knows the module
+pc_has = $(shell $(PKG_CONFIG) --exists $(1) 2>/dev/null && echo yes)
+# $(call cc_finds,name): non-empty when $(CC) finds libname.so or libname.a
+# (-print-file-name answers the bare name when it finds nothing)
+cc_finds = $(filter /%,$(shell $(CC) -print-file-name=lib$(1).so) $(shell $(CC) -print-file-name=lib$(1).a))
+# $(call uniq_last,words): each word once, at its last place
+uniq_last = $(if $(1),$(if $(filter $(firstword $(1)),$(wordlist 2,$(words $(1)),$(1))),,$(firstword $(1))) \
+            $(call uniq_last,$(wordlist 2,$(words $(1)),$(1))))
+
+PC_REQUIRES_PRIVATE_ = $(foreach m,$(PC_MATH_MODULES),$(if $(call pc_has,$(m)),$(m)))
+PC_MATH_STATIC_      = $(foreach m,$(PC_MATH_MODULES),$(if $(filter $(m),$(REQUIRES_PRIVATE)),$(shell \
+                           $(PKG_CONFIG) --static --libs-only-l $(m)),-l$(m))) -lm
+PC_STATIC_CANDIDATES_ = $(call uniq_last,$(if $(filter 1,$(HAVE_SUITESPARSE)),$(PC_SUITESPARSE_STATIC)) \
+                           $(PC_MATH_STATIC_) $(if $(filter -lgfortran,$(PC_MATH_STATIC_)),-lgfortran -lquadmath) \
+                           -lpthread -lm)
+PC_STATIC_MISSING_   = $(foreach l,$(filter $(PC_OPTIONAL_LIBS:%=-l%),$(PC_STATIC_CANDIDATES)), \
+                           $(if $(call cc_finds,$(l:-l%=%)),,$(l)))
+
+# The cached values (the $(eval) replaces each by its value on first use).
+PC_STATIC_CANDIDATES = $(eval PC_STATIC_CANDIDATES := $(strip $(PC_STATIC_CANDIDATES_)))$(PC_STATIC_CANDIDATES)
+REQUIRES_PRIVATE = $(eval REQUIRES_PRIVATE := $(strip $(PC_REQUIRES_PRIVATE_)))$(REQUIRES_PRIVATE)
+STATIC_MISSING   = $(eval STATIC_MISSING := $(strip $(PC_STATIC_MISSING_)))$(STATIC_MISSING)
+LIBS_PRIVATE     = $(eval LIBS_PRIVATE := $(filter-out $(STATIC_MISSING),$(PC_STATIC_CANDIDATES)))$(LIBS_PRIVATE)
 
 # ---------------------------------------------------------------------------
 # Compiler flags. ODHS_* are the fixed project flags; CFLAGS/CPPFLAGS/LDFLAGS
@@ -241,10 +301,6 @@ ifeq ($(HAVE_LAMMPS),1)
 EXAMPLE_BINS += build/examples/lammps_coupling
 endif
 
-PCTEST_DIR    := build/pkgconfig-test
-PCTEST_SHARED := $(PCTEST_DIR)/consumer-shared
-PCTEST_STATIC := $(PCTEST_DIR)/consumer-static
-
 BENCH_SRCS := $(sort $(wildcard bench/*.c))
 BENCH_BINS := $(BENCH_SRCS:bench/%.c=build/bench/%)
 
@@ -313,13 +369,13 @@ $(SHARED_DEVLINK): $(SHARED_SONAME)
 # ===========================================================================
 # Tests
 # ===========================================================================
-.PHONY: check check-run check-asan check-allocfail check-symbols check-readme tests
+.PHONY: check check-run check-asan check-allocfail check-symbols check-readme check-link tests
 
 # deps-if-missing runs first, then a fresh make instance does the work, so
 # that SUITESPARSE=auto and the pkg-config lookups see freshly installed
 # packages and `make -j check` cannot start compiling before apt-get is done.
 check: deps-if-missing
-	@$(MAKE) --no-print-directory check-symbols check-readme check-run
+	@$(MAKE) --no-print-directory check-symbols check-readme check-run check-link
 
 # Build the runner only.
 tests: $(TEST_RUNNER)
@@ -400,7 +456,9 @@ PC_FILE := $(BUILD)/odhs.pc
 # `pkg-config --define-prefix` can relocate an installed tree.
 pc_relative = $(patsubst $(PREFIX)/%,$${prefix}/%,$(1))
 
-# Regenerated whenever the substituted values change (PREFIX, SUITESPARSE...).
+# Regenerated whenever the substituted values change (PREFIX, SUITESPARSE...);
+# a Requires.private without modules (no lapacke.pc, lapack.pc, blas.pc) is
+# left out.
 $(PC_FILE): pkgconfig/odhs.pc.in FORCE
 	@mkdir -p $(@D)
 	@sed -e 's|@PREFIX@|$(PREFIX)|g' \
@@ -408,6 +466,9 @@ $(PC_FILE): pkgconfig/odhs.pc.in FORCE
 	     -e 's|@INCLUDEDIR@|$(call pc_relative,$(INCLUDEDIR))|g' \
 	     -e 's|@VERSION@|$(VERSION)|g' \
 	     -e 's|@LIBS_PRIVATE@|$(LIBS_PRIVATE)|g' \
+	     -e 's|@REQUIRES_PRIVATE@|$(REQUIRES_PRIVATE)|g' \
+	     -e 's|@STATIC_MISSING@|$(STATIC_MISSING)|g' \
+	     -e '/^Requires\.private: *$$/d' \
 	     $< > $@.tmp
 	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv -f $@.tmp $@; fi
 
@@ -492,28 +553,46 @@ else
 	@echo "check-mpi: SKIPPED: no MPI ($(MPICC) and $(MPIRUN) not both found; Debian: apt-get install openmpi-bin libopenmpi-dev, or make deps)"
 endif
 
+# The stand-alone consumer linked by every link line of the documents and by
+# pkg-config: shared, static libodhs.a, fully static (tests/link_check.sh
+# says which, and skips a fully static link that lacks a static library).
+# In a SuiteSparse build, check-link-nos then does the same against a build
+# without it, whose fully static link needs only LAPACK, BLAS and gcc's own
+# libraries (all there as .a on Debian, unlike METIS).
+check-link: stage
+	@$(MAKE) --no-print-directory pkgconfig-test-run
+ifeq ($(HAVE_SUITESPARSE),1)
+	@$(MAKE) --no-print-directory check-link-nos
+endif
+
+# SUITESPARSE=0 in build/link-nos (objects, libraries), installed into
+# build/link-nos/stage; linked with the pkg-config lines only.
+LINK_NOS := build/link-nos
+.PHONY: check-link-nos
+check-link-nos:
+	@echo "== building and installing a SUITESPARSE=0 libodhs into $(LINK_NOS)/stage (log: $(LINK_NOS)/build.log)"
+	@mkdir -p $(LINK_NOS)
+	@$(MAKE) --no-print-directory install SUITESPARSE=0 BUILD=$(LINK_NOS) OUT_LIBDIR=$(LINK_NOS)/lib \
+	    DESTDIR= PREFIX=$(CURDIR)/$(LINK_NOS)/stage LIBDIR=$(CURDIR)/$(LINK_NOS)/stage/lib \
+	    INCLUDEDIR=$(CURDIR)/$(LINK_NOS)/stage/include PC_FILE=$(LINK_NOS)/stage-odhs.pc \
+	    > $(LINK_NOS)/build.log 2>&1 || { tail -n 30 $(LINK_NOS)/build.log; exit 1; }
+	@echo "== linking $(TEST_STANDALONE) against it with pkg-config"
+	@CC="$(CC)" LINK_CHECK_CFLAGS="$(CONSUMER_CFLAGS)" LINK_CHECK_DIR=$(LINK_NOS)/link-check \
+	    bash tests/link_check.sh $(LINK_NOS)/stage $(TEST_STANDALONE)
+
 pkgconfig-test: stage
 	@$(MAKE) --no-print-directory pkgconfig-test-run
 
-.PHONY: pkgconfig-test-run
+.PHONY: pkgconfig-test-run print-libs
 pkgconfig-test-run:
-	@mkdir -p $(PCTEST_DIR)
-	@echo "== pkg-config consumer, shared: $$($(STAGE_PKG_CONFIG) --cflags --libs odhs)"
-	$(CC) $(CONSUMER_CFLAGS) -o $(PCTEST_SHARED) $(TEST_STANDALONE) \
-	    $$($(STAGE_PKG_CONFIG) --cflags --libs odhs) $(STAGE_RPATH)
-	./$(PCTEST_SHARED)
-	@readelf -d $(PCTEST_SHARED) | grep -q 'NEEDED.*\[$(SONAME)\]' || \
-	    { echo "pkgconfig-test: $(PCTEST_SHARED) does not need $(SONAME)"; exit 1; }
-	@# Static: link libodhs.a (-lodhs -> -l:libodhs.a, since the linker would
-	@# otherwise prefer the .so) with `pkg-config --static` Libs.private.
-	@echo "== pkg-config consumer, static: $$($(STAGE_PKG_CONFIG) --static --cflags --libs odhs)"
-	$(CC) $(CONSUMER_CFLAGS) -o $(PCTEST_STATIC) $(TEST_STANDALONE) \
-	    $$($(STAGE_PKG_CONFIG) --cflags odhs) \
-	    $$($(STAGE_PKG_CONFIG) --static --libs odhs | sed 's/\(^\|[[:space:]]\)-lodhs\([[:space:]]\|$$\)/\1-l:libodhs.a\2/')
-	./$(PCTEST_STATIC)
-	@! readelf -d $(PCTEST_STATIC) | grep -q 'NEEDED.*libodhs' || \
-	    { echo "pkgconfig-test: $(PCTEST_STATIC) still needs libodhs.so"; exit 1; }
-	@echo "pkgconfig-test: ok"
+	@echo "== linking $(TEST_STANDALONE): the link lines of README.md and docs/guide.md, pkg-config"
+	@CC="$(CC)" LINK_CHECK_CFLAGS="$(CONSUMER_CFLAGS)" LINK_CHECK_DIR=build/link-check \
+	    bash tests/link_check.sh $(STAGE) $(TEST_STANDALONE) README.md docs/guide.md
+
+# The libraries lib/libodhs.a needs, the system libraries being shared:
+#   gcc -std=c11 -Iinclude prog.c lib/libodhs.a $(make -s print-libs) -lm
+print-libs:
+	@echo '$(strip $(ODHS_LIBS))'
 
 demo:
 	@$(MAKE) --no-print-directory deps-if-missing
