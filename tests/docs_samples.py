@@ -135,6 +135,8 @@ def parse(doc):
             else:
                 pending.append((k, d))
             continue
+        if "docs-test" in line and "<!--" in line:
+            errors.append(f"{doc}:{k}: a docs-test comment must be a line of its own: <!-- docs-test: ... -->")
         if line.strip() and pending:
             errors.append(f"{doc}:{pending[0][0]}: docs-test comment not followed by a code block")
             pending = []
