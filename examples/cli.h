@@ -400,8 +400,57 @@ static inline int cli_solver(const char *prog, const char *name, odhs_solver **o
 {
     int rc = odhs_solver_create_by_name(name, out);
     if (!rc) return 0;
-    fprintf(stderr, "%s: solver %s: %s\n", prog, name, odhs_strerror(rc));
+    /* the library's message names the solvers this build has */
+    fprintf(stderr, "%s: solver %s: %s\n", prog, name, odhs_last_error()[0] ? odhs_last_error() : odhs_strerror(rc));
     return 2;
+}
+
+/* The built-in scene compressed to phi (shear_flow, lammps_coupling): the
+ * random placement of cli_scene, then event-driven isotropic compression to
+ * phi with solver and a drift correction, so that a run starts from contacts
+ * at exact touching. 0, or 1 with a message. */
+static inline int cli_compressed_scene(const char *prog, int dim, unsigned long n, double phi, unsigned long seed,
+                                       odhs_solver *solver, int quiet, odhs_system **out)
+{
+    odhs_system *sys = NULL;
+    odhs_driver *drv = NULL;
+    odhs_stepper *st = NULL;
+    double phi0 = dim == 2 ? 0.45 : 0.3;
+    if (phi < phi0) phi0 = phi;
+    int rc = cli_scene(dim, n, seed, phi, &sys);
+    if (rc) {
+        fprintf(stderr, "%s: %s\n", prog, sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
+        odhs_system_destroy(sys);
+        return 1;
+    }
+    if (phi > phi0) {
+        if ((rc = odhs_driver_create(&drv)) || (rc = odhs_driver_set_compression_rate(drv, 1.0)) ||
+            (rc = odhs_stepper_create(sys, drv, solver, &st)) || (rc = odhs_stepper_set_dt(st, 1e-3))) {
+            fprintf(stderr, "%s: setting up the compression: %s (%s)\n", prog, odhs_strerror(rc), odhs_last_error());
+            rc = 1;
+            goto done;
+        }
+        if (!quiet) fprintf(stderr, "%s: compressing from phi = %.3f to %.3f\n", prog, phi0, phi);
+        rc = odhs_stepper_run_until_packing_fraction(st, phi);
+        if (rc) {
+            fprintf(stderr, "%s: compression stopped: %s (%s)\n", prog, odhs_strerror(rc), odhs_stepper_errmsg(st));
+            rc = 1;
+            goto done;
+        }
+        /* contacts back to exact touching, so the run starts from them */
+        if (odhs_stepper_correct(st) < 0) {
+            fprintf(stderr, "%s: %s\n", prog, odhs_stepper_errmsg(st));
+            rc = 1;
+            goto done;
+        }
+    }
+    rc = 0;
+done:
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    if (rc) odhs_system_destroy(sys);
+    else *out = sys;
+    return rc;
 }
 
 /* whether path names a LAMMPS data file: it ends in .data, .lmp or .lammps,

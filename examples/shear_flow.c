@@ -92,46 +92,6 @@ static int output(outputs *o, odhs_stepper *st, odhs_system *sys, double x, doub
         }                                                                                       \
     } while (0)
 
-/* Build the default scene: RSA at a low packing fraction, then event-driven
- * isotropic compression to phi. */
-static int build_scene(int dim, unsigned long n, double phi, unsigned long seed, odhs_solver *solver, int quiet,
-                       odhs_system **out)
-{
-    odhs_system *sys = NULL;
-    double phi0 = dim == 2 ? 0.45 : 0.3;
-    if (phi < phi0) phi0 = phi;
-    int rc = cli_scene(dim, n, seed, phi, &sys);
-    if (rc) {
-        fprintf(stderr, "shear_flow: %s\n", sys ? odhs_system_errmsg(sys) : odhs_strerror(rc));
-        return 1;
-    }
-    if (phi > phi0) {
-        odhs_driver *drv;
-        odhs_stepper *st;
-        CHECK(odhs_driver_create(&drv));
-        CHECK(odhs_driver_set_compression_rate(drv, 1.0));
-        CHECK(odhs_stepper_create(sys, drv, solver, &st));
-        CHECK(odhs_stepper_set_dt(st, 1e-3));
-        if (!quiet) fprintf(stderr, "shear_flow: compressing from phi = %.3f to %.3f\n", phi0, phi);
-        rc = odhs_stepper_run_until_packing_fraction(st, phi);
-        if (rc) {
-            fprintf(stderr, "shear_flow: compression stopped: %s (%s)\n", odhs_strerror(rc),
-                    odhs_stepper_errmsg(st));
-            return 1;
-        }
-        /* contacts back to exact touching, so the shear run starts from them */
-        rc = odhs_stepper_correct(st);
-        if (rc < 0) {
-            fprintf(stderr, "shear_flow: %s\n", odhs_stepper_errmsg(st));
-            return 1;
-        }
-        odhs_stepper_destroy(st);
-        odhs_driver_destroy(drv);
-    }
-    *out = sys;
-    return 0;
-}
-
 /* --oscillate A,T[,sine|triangle]; 0 on success */
 static int parse_oscillate(const char *arg, double *amp, double *period, int *shape)
 {
@@ -372,7 +332,7 @@ int main(int argc, char **argv)
     }
 
     odhs_system *sys = NULL;
-    if (in ? cli_read_xyz(cli.prog, in, &sys) : build_scene(dim, n, phi, seed, solver, quiet, &sys)) return 1;
+    if (in ? cli_read_xyz(cli.prog, in, &sys) : cli_compressed_scene(cli.prog, dim, n, phi, seed, solver, quiet, &sys)) return 1;
     double phi_now;
     CHECK(odhs_system_packing_fraction(sys, &phi_now));
     n = odhs_system_count(sys);

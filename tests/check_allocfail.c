@@ -423,6 +423,8 @@ typedef struct {
     unsigned char mark[64];
     odhs_jam_certificate cert;
     double errs[2];
+    size_t ci[256], cj[256]; /* odhs_stepper_contacts (shear_callback) */
+    double cf[256];
     char dir[64], path1[128], path2[128], path3[128];
 } af_fix;
 
@@ -746,7 +748,9 @@ static void edit_final(af_fix *f, const af_scenario *sc) { check_network(f->net,
  *    self-propulsion (short persistence: most steps end at a switch, whose
  *    redraw a failed step must undo) and gravity with weights, 4 Euler + cg
  *    capped at one iteration with a dense fallback (every solve goes through
- *    it), 5 Heun + dense at p = 1e4 (isostatic networks flow). The
+ *    it), 5 Heun + dense at p = 1e4 (isostatic networks flow), 6 Heun +
+ *    dense with a force callback in physical time, stepped with step_ex and
+ *    read with odhs_stepper_contacts (0.2.7). The
  *    driver also carries (zero) external forces, so that their code paths
  *    run too. */
 enum {
@@ -762,6 +766,19 @@ enum {
     SH_NOPS
 };
 
+/* a pure force callback (shear_callback) */
+static int af_swirl(double t, const odhs_system *sys, double *F, void *ctx)
+{
+    (void)ctx;
+    double x[64];
+    if (odhs_system_get_positions(sys, x)) return 1;
+    for (int i = 0; i < 32; ++i) {
+        F[2 * i] = 0.2 * sin(x[2 * i + 1] + t);
+        F[2 * i + 1] = 0.2 * cos(x[2 * i]);
+    }
+    return 0;
+}
+
 static void shear_setup(af_fix *f, const af_scenario *sc)
 {
     (void)sc;
@@ -773,7 +790,16 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
     int v = sc->variant;
     if (k >= SH_STEPS1 && k < SH_REVERSE) return odhs_stepper_step(f->st, NULL);
     if (k >= SH_STEPS2 && k < SH_FASTER) return odhs_stepper_step(f->st, NULL);
-    if (k >= SH_STEPS3 && k < SH_CORRECT) return odhs_stepper_step(f->st, NULL);
+    if (k >= SH_STEPS3 && k < SH_CORRECT) {
+        if (v != 6) return odhs_stepper_step(f->st, NULL);
+        odhs_step_info in; /* 6: the embedding calls of 0.2.7 */
+        memset(&in, 0, sizeof in);
+        in.size = sizeof in;
+        int s = odhs_stepper_step_ex(f->st, &in);
+        size_t nc;
+        if (s >= 0) s = odhs_stepper_contacts(f->st, 256, &nc, f->ci, f->cj, NULL, f->cf, NULL);
+        return s;
+    }
     switch (k) {
     case 0: return odhs_driver_create(&f->drv);
     case 1: {
@@ -801,17 +827,21 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
             f->sol2 = dn;
             return ODHS_OK;
         }
-        return odhs_solver_create_by_name(v == 1 || v == 3 || v == 5 ? "dense" : "cg", &f->sol);
+        return odhs_solver_create_by_name(v == 1 || v == 3 || v == 5 || v == 6 ? "dense" : "cg", &f->sol);
     case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
     case 4: return odhs_stepper_set_dt(f->st, 0.02);
     case 5:
-        return odhs_stepper_set_integrator(f->st, v == 1 || v == 3 || v == 5 ? ODHS_INTEGRATOR_HEUN
+        return odhs_stepper_set_integrator(f->st, v == 1 || v == 3 || v == 5 || v == 6 ? ODHS_INTEGRATOR_HEUN
                                                                              : ODHS_INTEGRATOR_EULER);
     case 6: return odhs_stepper_set_contact_tolerance(f->st, 1e-2);
     case SH_FORCES: {
         double F[64];
         memset(F, 0, sizeof F);
         int s = odhs_driver_set_forces(f->drv, 32, 2, F);
+        /* 6: a force callback (re-evaluated after every drift correction) in
+         * physical time */
+        if (!s && v == 6) s = odhs_driver_set_force_callback(f->drv, af_swirl, NULL);
+        if (!s && v == 6) s = odhs_driver_set_time_unit(f->drv, 1.0);
         if (!s && v == 3) {
             double g[2] = {0.0, -0.3}, w[32];
             for (int i = 0; i < 32; ++i) w[i] = 1.0 + 0.05 * i;
@@ -1366,6 +1396,7 @@ static const af_scenario scenarios[] = {
     {"shear_propulsion", SH_NOPS, 3, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_cg_fallback", SH_NOPS, 4, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_pressure_high", SH_NOPS, 5, shear_setup, NULL, shear_op, shear_capture, shear_final},
+    {"shear_callback", SH_NOPS, 6, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"outputs", 8, 0, outputs_setup, NULL, outputs_op, outputs_capture, outputs_final},

@@ -162,7 +162,9 @@ ODHS_API int odhs_driver_set_forces(odhs_driver *drv, size_t n, int dim, const d
  *  Timing (the callback must be a pure function of t and the positions):
  *  the stepper asks for the forces whenever it needs them at a new state:
  *  at odhs_stepper_reset (the current time), at the end of every step (its
- *  end time and positions), with the Heun integrator also at the
+ *  end time and positions, and since 0.2.7 again after the drift correction
+ *  moved them, so that the forces belong to the final positions), with the
+ *  Heun integrator also at the
  *  predictor (the planned end time t0 + h of the step, on positions
  *  x0 + h V0 that are not on the trajectory), again when a step is repeated
  *  shorter (a collision or an opening inside it) and after a driver change.
