@@ -94,7 +94,7 @@ static uint64_t fnv1a(const unsigned char *p, size_t len)
 
 static int is_status(int rc)
 {
-    return (rc >= ODHS_E_INTERNAL && rc <= ODHS_JAMMED);
+    return (rc >= ODHS_E_STALLED && rc <= ODHS_STEP_LIMIT);
 }
 
 static unsigned char *slurp(const char *path, size_t *len)
