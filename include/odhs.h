@@ -19,5 +19,6 @@
 #include "odhs/softcore.h"
 #include "odhs/traj.h"
 #include "odhs/lammps.h"
+#include "odhs/analysis.h"
 
 #endif /* ODHS_H */

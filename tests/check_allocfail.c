@@ -425,6 +425,10 @@ typedef struct {
     double errs[2];
     size_t ci[256], cj[256]; /* odhs_stepper_contacts (shear_callback) */
     double cf[256];
+    /* the analysis scenario's outputs */
+    odhs_series_stats stats;
+    double an_e[9], an_d[8], an_g[8], an_gap[256], an_series[512], an_V[64];
+    size_t an_n[2];
     char dir[64], path1[128], path2[128], path3[128];
 } af_fix;
 
@@ -1384,6 +1388,41 @@ static void soft_final(af_fix *f, const af_scenario *sc)
     AF_MSG(U >= 0.0, "%s: energy %g", sc->name, U);
 }
 
+/* -- analysis: series statistics, a histogram of the forces, the backbone's
+ *    forces, the gaps of nearly touching pairs, the velocity correlation --- */
+static void analysis_setup(af_fix *f, const af_scenario *sc)
+{
+    files_setup(f, sc);
+    for (int k = 0; k < 512; ++k) f->an_series[k] = sin(0.37 * k) + 0.01 * (k % 7);
+    for (int k = 0; k < 64; ++k) f->an_V[k] = cos(0.9 * k);
+    f->stats.size = sizeof f->stats;
+}
+static int analysis_op(af_fix *f, const af_scenario *sc, int k)
+{
+    (void)sc;
+    switch (k) {
+    case 0: return odhs_series_stats_compute(f->an_series, 512, &f->stats);
+    case 1: return odhs_histogram(f->an_series, 512, -1.0, 1.0, 8, 0, f->an_e, f->an_d, NULL, NULL);
+    case 2: return odhs_backbone_forces(f->net, 256, &f->an_n[0], f->cf);
+    case 3: return odhs_packing_gaps(f->sys, f->net, 0.3, 256, &f->an_n[1], NULL, NULL, f->an_gap, NULL);
+    case 4: return odhs_velocity_correlation(f->sys, f->an_V, 1.0, 8, f->an_g, NULL);
+    }
+    return ODHS_E_INTERNAL;
+}
+static void analysis_capture(const af_fix *f, const af_scenario *sc, int op, af_buf *b)
+{
+    (void)sc;
+    (void)op;
+    rec_system(b, "sys", f->sys);
+    rec_network(b, "net", f->net);
+    rec(b, "stats", 'c', &f->stats, sizeof f->stats);
+    rec(b, "hist", 'd', f->an_e, 9);
+    rec(b, "dens", 'd', f->an_d, 8);
+    rec(b, "counts", 'z', f->an_n, 2);
+    rec(b, "backbone", 'd', f->cf, 256);
+    rec(b, "vcorr", 'd', f->an_g, 8);
+}
+
 static const af_scenario scenarios[] = {
     {"build_2d", 8, 0, build_setup_none, NULL, build_op, build_capture, build_final},
     {"build_3d", 8, 1, build_setup_none, NULL, build_op, build_capture, build_final},
@@ -1399,6 +1438,7 @@ static const af_scenario scenarios[] = {
     {"shear_callback", SH_NOPS, 6, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
+    {"analysis", 5, 0, analysis_setup, NULL, analysis_op, analysis_capture, files_final},
     {"outputs", 8, 0, outputs_setup, NULL, outputs_op, outputs_capture, outputs_final},
     {"checkpoint", 3, 0, ckpt_setup, NULL, ckpt_op, ckpt_capture, ckpt_final},
     {"softcore", SC_NOPS, 0, soft_setup, NULL, soft_op, soft_capture, soft_final},

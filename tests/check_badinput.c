@@ -2169,6 +2169,68 @@ static int traj_status(odhs_traj *tr, int rc)
     X(sc_reset_ok, odhs_softcore_reset, ODHS_OK, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, odhs_softcore_reset(sc));) \
     X(sc_counts_ok, odhs_softcore_counts, ODHS_OK, NOALT, H_NONE, 0, odhs_softcore *sc = sc_new(w); if (!sc) return post("create"); return sc_done(sc, sc_counts(sc));)
 
+/* the analysis calls (analysis.h, 0.2.7) */
+#define ANALYSIS_CASES(X)                                                                                      \
+    X(an_stats_null, odhs_series_stats_compute, ODHS_E_NULL, NOALT, H_NONE, 0,                                 \
+      double x[8] = {0}; (void)x; return odhs_series_stats_compute(x, 8, NULL);)                               \
+    X(an_stats_short, odhs_series_stats_compute, ODHS_E_EMPTY, NOALT, H_NONE, 0,                               \
+      double x[3] = {1, 2, 3}; odhs_series_stats o; memset(&o, 0, sizeof o); o.size = sizeof o;                \
+      int rc = odhs_series_stats_compute(x, 3, &o);                                                            \
+      return o.n != 0 ? post("output written") : !odhs_last_error()[0] ? post("no message") : rc;)             \
+    X(an_stats_nan, odhs_series_stats_compute, ODHS_E_NONFINITE, NOALT, H_NONE, 0,                             \
+      double x[6] = {1, 2, NAN_, 3, 4, 5}; odhs_series_stats o; memset(&o, 0, sizeof o); o.size = sizeof o;    \
+      return odhs_series_stats_compute(x, 6, &o);)                                                             \
+    X(an_stats_size0, odhs_series_stats_compute, ODHS_E_INVALID, NOALT, H_NONE, 0,                             \
+      double x[6] = {1, 2, 3, 4, 5, 6}; odhs_series_stats o; memset(&o, 0, sizeof o);                          \
+      return odhs_series_stats_compute(x, 6, &o);)                                                             \
+    X(an_acf_lag, odhs_series_autocorrelation, ODHS_E_RANGE, NOALT, H_NONE, 0,                                 \
+      double x[6] = {1, 2, 3, 4, 5, 6}, rho[8]; return odhs_series_autocorrelation(x, 6, 6, rho);)             \
+    X(an_acf_null, odhs_series_autocorrelation, ODHS_E_NULL, NOALT, H_NONE, 0,                                 \
+      double x[6] = {1, 2, 3, 4, 5, 6}; return odhs_series_autocorrelation(x, 6, 2, NULL);)                    \
+    X(an_hist_range, odhs_histogram, ODHS_E_INVALID, NOALT, H_NONE, 0,                                         \
+      double x[2] = {1, 2}, e[3], d[2]; return odhs_histogram(x, 2, 1.0, 1.0, 2, 0, e, d, NULL, NULL);)        \
+    X(an_hist_log0, odhs_histogram, ODHS_E_INVALID, NOALT, H_NONE, 0,                                          \
+      double x[2] = {1, 2}, e[3], d[2]; return odhs_histogram(x, 2, 0.0, 3.0, 2, 1, e, d, NULL, NULL);)        \
+    X(an_hist_empty, odhs_histogram, ODHS_E_EMPTY, NOALT, H_NONE, 0,                                           \
+      double x[2] = {1, 2}, e[3], d[2]; return odhs_histogram(x, 2, 0.0, 3.0, 0, 0, e, d, NULL, NULL);)        \
+    X(an_hist_nan, odhs_histogram, ODHS_E_NONFINITE, NOALT, H_NONE, 0,                                         \
+      double x[2] = {1, INF_}, e[3], d[2]; return odhs_histogram(x, 2, 0.0, 3.0, 2, 0, e, d, NULL, NULL);)     \
+    X(an_hist_null, odhs_histogram, ODHS_E_NULL, NOALT, H_NONE, 0,                                             \
+      double x[2] = {1, 2}, d[2]; return odhs_histogram(x, 2, 0.0, 3.0, 2, 0, NULL, d, NULL, NULL);)           \
+    X(an_pow_xmax, odhs_power_law_exponent, ODHS_E_INVALID, NOALT, H_NONE, 0,                                  \
+      double x[2] = {1, 2}, a; return odhs_power_law_exponent(x, 2, 0.0, &a, NULL, NULL);)                     \
+    X(an_pow_few, odhs_power_law_exponent, ODHS_E_EMPTY, NOALT, H_NONE, 0,                                     \
+      double x[3] = {0.5, 2, 3}, a = 7; int rc = odhs_power_law_exponent(x, 3, 1.0, &a, NULL, NULL);           \
+      return a != 7 ? post("output written") : rc;)                                                            \
+    X(an_pow_null, odhs_power_law_exponent, ODHS_E_NULL, NOALT, H_NONE, 0,                                     \
+      double x[2] = {1, 2}; return odhs_power_law_exponent(x, 2, 1.0, NULL, NULL, NULL);)                      \
+    X(an_backbone_null, odhs_backbone_forces, ODHS_E_NULL, NOALT, H_NONE, 0,                                   \
+      size_t n; return odhs_backbone_forces(NULL, 0, &n, NULL);)                                               \
+    X(an_backbone_null_n, odhs_backbone_forces, ODHS_E_NULL, NOALT, H_NET2, 0,                                 \
+      return odhs_backbone_forces(w->net2, 0, NULL, NULL);)                                                    \
+    X(an_gaps_null, odhs_packing_gaps, ODHS_E_NULL, NOALT, H_NONE, 0,                                          \
+      size_t n; return odhs_packing_gaps(NULL, w->net2, 0.1, 0, &n, NULL, NULL, NULL, NULL);)                  \
+    X(an_gaps_maxgap, odhs_packing_gaps, ODHS_E_INVALID, NOALT, H_SYS2, 0,                                     \
+      size_t n = 5; int rc = odhs_packing_gaps(w->sys2, w->net2, 2.0, 0, &n, NULL, NULL, NULL, NULL);          \
+      return n != 5 ? post("count written") : rc;)                                                             \
+    X(an_gaps_other_net, odhs_packing_gaps, ODHS_E_DIM, NOALT, H_SYS3, 0,                                      \
+      size_t n; return odhs_packing_gaps(w->sys3, w->net2, 0.1, 0, &n, NULL, NULL, NULL, NULL);)               \
+    X(an_gaps_bare, odhs_packing_gaps, ODHS_E_STATE, NOALT, H_BARE, 0,                                         \
+      size_t n; return odhs_packing_gaps(w->bare, w->net2, 0.1, 0, &n, NULL, NULL, NULL, NULL);)               \
+    X(an_vcorr_null, odhs_velocity_correlation, ODHS_E_NULL, NOALT, H_SYS2, 0,                                 \
+      double g[4]; return odhs_velocity_correlation(w->sys2, NULL, 0.5, 4, g, NULL);)                          \
+    X(an_vcorr_width, odhs_velocity_correlation, ODHS_E_INVALID, NOALT, H_SYS2, 0,                             \
+      double V[32] = {0}, g[4]; return odhs_velocity_correlation(w->sys2, V, -1.0, 4, g, NULL);)               \
+    X(an_vcorr_zero, odhs_velocity_correlation, ODHS_E_EMPTY, NOALT, H_SYS2, 0,                                \
+      double V[32] = {0}, g[4]; return odhs_velocity_correlation(w->sys2, V, 0.5, 4, g, NULL);)                \
+    X(an_vcorr_nan, odhs_velocity_correlation, ODHS_E_NONFINITE, NOALT, H_SYS2, 0,                             \
+      double V[32] = {0}, g[4]; V[3] = NAN_; return odhs_velocity_correlation(w->sys2, V, 0.5, 4, g, NULL);)   \
+    X(an_min_null, odhs_correlation_minimum, ODHS_E_NULL, NOALT, H_NONE, 0,                                    \
+      double g[3] = {1, 0, 1}; return odhs_correlation_minimum(g, 3, NULL, NULL);)                             \
+    X(an_min_none, odhs_correlation_minimum, ODHS_E_EMPTY, NOALT, H_NONE, 0,                                   \
+      double g[3] = {1, 0.5, 0.2}, x = 9; int rc = odhs_correlation_minimum(g, 3, &x, NULL);                   \
+      return x != 9 ? post("output written") : rc;)
+
 /* the embedding calls of 0.2.7 (issue 19): messages of failed creates,
  * solver names, the system's change counter, step info with a size, run
  * limits, bulk contacts */
@@ -2338,6 +2400,7 @@ CHECKPOINT_CASES(X_DEFINE)
 SOFTCORE_CASES(X_DEFINE)
 OUTPUT_CASES(X_DEFINE)
 EMBED_CASES(X_DEFINE)
+ANALYSIS_CASES(X_DEFINE)
 REGRESSION_CASES(X_DEFINE)
 
 static const bad_case common_cases[] = {COMMON_CASES(X_ROW)};
@@ -2352,6 +2415,7 @@ static const bad_case checkpoint_cases[] = {CHECKPOINT_CASES(X_ROW)};
 static const bad_case softcore_cases[] = {SOFTCORE_CASES(X_ROW)};
 static const bad_case output_cases[] = {OUTPUT_CASES(X_ROW)};
 static const bad_case embed_cases[] = {EMBED_CASES(X_ROW)};
+static const bad_case analysis_cases[] = {ANALYSIS_CASES(X_ROW)};
 static const bad_case regression_cases[] = {REGRESSION_CASES(X_ROW)};
 
 #define NROWS(t) ((int)(sizeof t / sizeof t[0]))
@@ -2366,6 +2430,7 @@ static const struct {
     {stepper_cases, NROWS(stepper_cases)}, {jamming_cases, NROWS(jamming_cases)},
     {checkpoint_cases, NROWS(checkpoint_cases)}, {softcore_cases, NROWS(softcore_cases)},
     {output_cases, NROWS(output_cases)},   {embed_cases, NROWS(embed_cases)},
+    {analysis_cases, NROWS(analysis_cases)},
     {regression_cases, NROWS(regression_cases)},
 };
 
@@ -2443,6 +2508,7 @@ TABLE_TEST(test_checkpoint, checkpoint_cases)
 TABLE_TEST(test_softcore, softcore_cases)
 TABLE_TEST(test_output, output_cases)
 TABLE_TEST(test_embed, embed_cases)
+TABLE_TEST(test_analysis, analysis_cases)
 TABLE_TEST(test_regression, regression_cases)
 
 /* ---- coverage: every function declared in the public headers has a row ----- */
@@ -2543,6 +2609,7 @@ Suite *make_badinput_suite(void)
         {"softcore", test_softcore, NROWS(softcore_cases)},
         {"output", test_output, NROWS(output_cases)},
         {"embed", test_embed, NROWS(embed_cases)},
+        {"analysis", test_analysis, NROWS(analysis_cases)},
         {"regression", test_regression, NROWS(regression_cases)},
     };
     for (size_t k = 0; k < sizeof tcs / sizeof tcs[0]; ++k) {

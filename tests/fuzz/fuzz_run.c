@@ -46,8 +46,8 @@ static double logval(rd *r, double lo, double hi) { return pow(10.0, lo + (hi - 
 /* every run call is capped (the step limit): a run that progresses may
  * legitimately take long (a strain of 1e11 to reach a packing fraction under
  * a shear rate of 1e14); one that does not must be ended by the stall guard
- * (stall_steps <= 256 + 1000 < FUZZ_MAX_STEPS) or the no-event check */
-#define FUZZ_MAX_STEPS 1500
+ * (stall_steps <= 400 < FUZZ_MAX_STEPS) or the no-event check */
+#define FUZZ_MAX_STEPS 500
 
 #define FAIL(...)                                                                                                    \
     do {                                                                                                             \
@@ -128,7 +128,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     odhs_stepper_set_integrator(st, (flags & 2048) ? ODHS_INTEGRATOR_EULER : ODHS_INTEGRATOR_HEUN);
     if (flags & 4096) odhs_stepper_set_dt(st, logval(&r, -300, 3));
     if (flags & 8192) odhs_stepper_set_tolerance(st, logval(&r, -12, -1));
-    uint64_t stall = (flags & 16384) ? 1 + u8(&r) : 1000;
+    uint64_t stall = (flags & 16384) ? 1 + u8(&r) : 400; /* below FUZZ_MAX_STEPS */
     odhs_stepper_set_run_limits(st, FUZZ_MAX_STEPS, stall);
 
     int ncalls = 1 + u8(&r) % 8;
