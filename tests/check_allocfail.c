@@ -429,6 +429,7 @@ typedef struct {
     odhs_series_stats stats;
     double an_e[9], an_d[8], an_g[8], an_gap[256], an_series[512], an_V[64];
     size_t an_n[2];
+    odhs_collapse coll;
     char dir[64], path1[128], path2[128], path3[128];
 } af_fix;
 
@@ -1389,13 +1390,15 @@ static void soft_final(af_fix *f, const af_scenario *sc)
 }
 
 /* -- analysis: series statistics, a histogram of the forces, the backbone's
- *    forces, the gaps of nearly touching pairs, the velocity correlation --- */
+ *    forces, the gaps of nearly touching pairs, the velocity correlation, a
+ *    scaling collapse ------------------------------------------------------- */
 static void analysis_setup(af_fix *f, const af_scenario *sc)
 {
     files_setup(f, sc);
     for (int k = 0; k < 512; ++k) f->an_series[k] = sin(0.37 * k) + 0.01 * (k % 7);
     for (int k = 0; k < 64; ++k) f->an_V[k] = cos(0.9 * k);
     f->stats.size = sizeof f->stats;
+    f->coll.size = sizeof f->coll;
 }
 static int analysis_op(af_fix *f, const af_scenario *sc, int k)
 {
@@ -1406,6 +1409,17 @@ static int analysis_op(af_fix *f, const af_scenario *sc, int k)
     case 2: return odhs_backbone_forces(f->net, 256, &f->an_n[0], f->cf);
     case 3: return odhs_packing_gaps(f->sys, f->net, 0.3, 256, &f->an_n[1], NULL, NULL, f->an_gap, NULL);
     case 4: return odhs_velocity_correlation(f->sys, f->an_V, 1.0, 8, f->an_g, NULL);
+    case 5: { /* a collapse of a synthetic flow curve (exponents 0.84, 1, 3) */
+        double phi[24], rate[24], v[24];
+        for (int k = 0; k < 24; ++k) {
+            phi[k] = 0.82 + 0.005 * (k % 8);
+            rate[k] = pow(10.0, -6.0 + k / 8);
+            double x = (phi[k] - 0.84) / pow(rate[k], 1.0 / 3.0);
+            v[k] = pow(rate[k], 1.0 / 3.0) * exp(0.2 + x + 0.05 * x * x);
+        }
+        const double guess[3] = {0.835, 0.9, 3.2};
+        return odhs_collapse_fit(phi, rate, v, NULL, 24, 2, guess, &f->coll);
+    }
     }
     return ODHS_E_INTERNAL;
 }
@@ -1421,6 +1435,7 @@ static void analysis_capture(const af_fix *f, const af_scenario *sc, int op, af_
     rec(b, "counts", 'z', f->an_n, 2);
     rec(b, "backbone", 'd', f->cf, 256);
     rec(b, "vcorr", 'd', f->an_g, 8);
+    rec(b, "collapse", 'c', &f->coll, sizeof f->coll);
 }
 
 static const af_scenario scenarios[] = {
@@ -1438,7 +1453,7 @@ static const af_scenario scenarios[] = {
     {"shear_callback", SH_NOPS, 6, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
-    {"analysis", 5, 0, analysis_setup, NULL, analysis_op, analysis_capture, files_final},
+    {"analysis", 6, 0, analysis_setup, NULL, analysis_op, analysis_capture, files_final},
     {"outputs", 8, 0, outputs_setup, NULL, outputs_op, outputs_capture, outputs_final},
     {"checkpoint", 3, 0, ckpt_setup, NULL, ckpt_op, ckpt_capture, ckpt_final},
     {"softcore", SC_NOPS, 0, soft_setup, NULL, soft_op, soft_capture, soft_final},

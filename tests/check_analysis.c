@@ -379,6 +379,55 @@ START_TEST(test_correlation_minimum)
 }
 END_TEST
 
+/* ---- scaling collapse ---------------------------------------------------------- */
+START_TEST(test_collapse_synthetic)
+{
+    /* O = rate^(y/znu) exp(G(x)), x = (phi - phi_J)/rate^(1/znu), G a cubic,
+     * with 1 % noise: phi_J = 0.8433, y = 1.1, z nu = 3.5 (the thesis' RD0
+     * values) recovered within 3 errors; errors shrink with the noise */
+    const double pj = 0.8433, y = 1.1, znu = 3.5;
+    const double rates[] = {1e-7, 1e-6, 1e-5, 1e-4};
+    enum { NPHI = 11, NR = 4, NP = NPHI * NR };
+    double phi[NP], rate[NP], val[NP], err[NP];
+    for (int noise = 0; noise < 2; ++noise) {
+        tu_rng r;
+        tu_rng_seed(&r, 77);
+        for (int a = 0; a < NR; ++a)
+            for (int b = 0; b < NPHI; ++b) {
+                int k = a * NPHI + b;
+                phi[k] = 0.83 + 0.003 * b;
+                rate[k] = rates[a];
+                double x = (phi[k] - pj) / pow(rate[k], 1.0 / znu);
+                double G = 0.3 + 1.2 * x - 0.1 * x * x + 0.02 * x * x * x;
+                double e = noise ? 0.01 : 1e-4;
+                val[k] = pow(rate[k], y / znu) * exp(G) * (1.0 + e * normal(&r));
+                err[k] = e;
+            }
+        odhs_collapse c;
+        memset(&c, 0, sizeof c);
+        c.size = sizeof c;
+        const double guess[3] = {0.84, 1.0, 3.0};
+        int s = odhs_collapse_fit(phi, rate, val, err, NP, 3, guess, &c);
+        ck_assert_msg(s == ODHS_OK, "collapse: %d (%s)", s, odhs_last_error());
+        printf("[analysis] collapse, %s noise: phi_J %.5f +- %.5f, y %.3f +- %.3f, z nu %.3f +- %.3f, chi2/dof %.2f "
+               "(%u evaluations)\n",
+               noise ? "1 %" : "0.01 %", c.phi_j, c.phi_j_err, c.y, c.y_err, c.znu, c.znu_err, c.chi2 / (double)c.dof,
+               c.evaluations);
+        ck_assert_msg(fabs(c.phi_j - pj) < 3.0 * c.phi_j_err + 1e-6, "phi_J %g +- %g", c.phi_j, c.phi_j_err);
+        ck_assert_msg(fabs(c.y - y) < 3.0 * c.y_err + 1e-4, "y %g +- %g", c.y, c.y_err);
+        ck_assert_msg(fabs(c.znu - znu) < 3.0 * c.znu_err + 1e-4, "z nu %g +- %g", c.znu, c.znu_err);
+        ck_assert_msg(c.chi2 / (double)c.dof < 2.0, "chi2/dof %g", c.chi2 / (double)c.dof);
+        ck_assert_msg(c.phi_j_err < (noise ? 2e-3 : 2e-5), "phi_J error %g", c.phi_j_err);
+        ck_assert(c.dof == NP - 4 - 3 && c.degree == 3 && fabs(c.q - c.y / c.znu) < 1e-15);
+    }
+    /* one rate only: the exponents are not determined */
+    odhs_collapse c;
+    memset(&c, 0, sizeof c);
+    c.size = sizeof c;
+    ck_assert_int_eq(odhs_collapse_fit(phi, rate, val, err, NPHI, 3, NULL, &c), ODHS_E_EMPTY);
+}
+END_TEST
+
 Suite *make_analysis_suite(void)
 {
     Suite *s = suite_create("analysis");
@@ -392,6 +441,7 @@ Suite *make_analysis_suite(void)
     tcase_add_test(tc, test_jammed_packing);
     tcase_add_test(tc, test_velocity_correlation);
     tcase_add_test(tc, test_correlation_minimum);
+    tcase_add_test(tc, test_collapse_synthetic);
     suite_add_tcase(s, tc);
     return s;
 }

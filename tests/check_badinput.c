@@ -2227,6 +2227,25 @@ static int traj_status(odhs_traj *tr, int rc)
       double V[32] = {0}, g[4]; V[3] = NAN_; return odhs_velocity_correlation(w->sys2, V, 0.5, 4, g, NULL);)   \
     X(an_min_null, odhs_correlation_minimum, ODHS_E_NULL, NOALT, H_NONE, 0,                                    \
       double g[3] = {1, 0, 1}; return odhs_correlation_minimum(g, 3, NULL, NULL);)                             \
+    X(an_collapse_null, odhs_collapse_fit, ODHS_E_NULL, NOALT, H_NONE, 0,                                      \
+      double a[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9}; return odhs_collapse_fit(a, a, a, NULL, 9, 3, NULL, NULL);)   \
+    X(an_collapse_few, odhs_collapse_fit, ODHS_E_EMPTY, NOALT, H_NONE, 0,                                      \
+      double a[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9}; odhs_collapse c; memset(&c, 0, sizeof c); c.size = sizeof c;  \
+      int rc = odhs_collapse_fit(a, a, a, NULL, 7, 3, NULL, &c); return c.y != 0 ? post("written") : rc;)      \
+    X(an_collapse_degree, odhs_collapse_fit, ODHS_E_INVALID, NOALT, H_NONE, 0,                                 \
+      double a[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9}; odhs_collapse c; memset(&c, 0, sizeof c); c.size = sizeof c;  \
+      return odhs_collapse_fit(a, a, a, NULL, 9, 8, NULL, &c);)                                                \
+    X(an_collapse_rate, odhs_collapse_fit, ODHS_E_INVALID, NOALT, H_NONE, 0,                                   \
+      double a[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9}, r[9] = {1, 2, 3, 4, 0, 6, 7, 8, 9};                            \
+      odhs_collapse c; memset(&c, 0, sizeof c); c.size = sizeof c;                                             \
+      return odhs_collapse_fit(a, r, a, NULL, 9, 3, NULL, &c);)                                                \
+    X(an_collapse_nan, odhs_collapse_fit, ODHS_E_NONFINITE, NOALT, H_NONE, 0,                                  \
+      double a[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9}, v[9] = {1, 2, 3, 4, NAN_, 6, 7, 8, 9};                         \
+      odhs_collapse c; memset(&c, 0, sizeof c); c.size = sizeof c;                                             \
+      return odhs_collapse_fit(a, a, v, NULL, 9, 3, NULL, &c);)                                                \
+    X(an_collapse_size0, odhs_collapse_fit, ODHS_E_INVALID, NOALT, H_NONE, 0,                                  \
+      double a[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9}; odhs_collapse c; memset(&c, 0, sizeof c);                     \
+      return odhs_collapse_fit(a, a, a, NULL, 9, 3, NULL, &c);)                                                \
     X(an_min_none, odhs_correlation_minimum, ODHS_E_EMPTY, NOALT, H_NONE, 0,                                   \
       double g[3] = {1, 0.5, 0.2}, x = 9; int rc = odhs_correlation_minimum(g, 3, &x, NULL);                   \
       return x != 9 ? post("output written") : rc;)

@@ -290,5 +290,26 @@ expect_in sc.data "^Atoms # sphere" "softcore_shear --out writes a LAMMPS data f
 expect 0 "minimal --help" -- "$bin/minimal" --help
 expect_in out "^usage: " "minimal --help prints usage"
 expect 2 "minimal bad option" -- "$bin/minimal" --n 5
+# collapse: synthetic flow curves with phi_J = 0.8433, y = 1.1, z nu = 3.5
+# (1 % noise, fixed): the fit recovers them within 3 errors, draws the plot
+expect 0 "collapse help" -- "$bin/collapse" --help
+expect_in out "usage: collapse" "collapse --help prints usage"
+expect 2 "collapse without --data" -- "$bin/collapse"
+expect 2 "collapse bad --guess" -- "$bin/collapse" --data x.csv --guess 0.8
+expect 2 "collapse bad --degree" -- "$bin/collapse" --data x.csv --degree 9
+expect 1 "collapse missing file" -- "$bin/collapse" --data "$tmp/no-such.csv"
+awk 'BEGIN { srand(5); print "phi,rate,shear_stress"
+    split("1e-7 1e-6 1e-5 1e-4", r, " ")
+    for (a = 1; a <= 4; ++a) for (b = 0; b <= 10; ++b) {
+        phi = 0.83 + 0.003 * b; x = (phi - 0.8433) / r[a] ^ (1 / 3.5)
+        g = 0.3 + 1.2 * x - 0.1 * x * x + 0.02 * x * x * x
+        noise = 0.01 * ((b * 7 + a * 3) % 11 - 5) / 5
+        printf "%.4f,%s,%.10g\n", phi, r[a], r[a] ^ (1.1 / 3.5) * exp(g) * (1 + noise) } }' > "$tmp/flow.csv"
+expect 0 "collapse synthetic" -- "$bin/collapse" --data "$tmp/flow.csv" --guess 0.84,1,3 --plot "$tmp/col.svg" --quiet
+awk '/^phi_J/ { ok1 = ($3 - 0.8433)^2 <= 9 * $5^2 } /^y / { ok2 = ($3 - 1.1)^2 <= 9 * $5^2 }
+     /^z nu/ { ok3 = ($4 - 3.5)^2 <= 9 * $6^2 } END { exit !(ok1 && ok2 && ok3) }' "$tmp/out" \
+    && pass=$((pass + 1)) || { echo "FAIL: collapse recovers phi_J, y, z nu"; sed 's/^/  | /' "$tmp/out"; fail=$((fail + 1)); }
+[ "$(grep -c '<circle\|<rect\|<path\|<polygon' "$tmp/col.svg")" -gt 44 ] && pass=$((pass + 1)) \
+    || { echo "FAIL: collapse plot"; fail=$((fail + 1)); }
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -175,6 +175,48 @@ ODHS_API int odhs_velocity_correlation(const odhs_system *sys, const double *V, 
  */
 ODHS_API int odhs_correlation_minimum(const double *g, size_t nbins, double *x, double *gmin);
 
+/* ---- scaling collapse of flow curves ------------------------------------------ */
+
+/**
+ * Result of odhs_collapse_fit (set `size` = sizeof before the call). The
+ * scaling form of an observable O (shear stress, pressure) near jamming,
+ * eq. (5.2) of Vagberg's thesis (Olsson and Teitel 2007):
+ *     O(phi, rate) = rate^(y / z nu) F((phi - phi_J) / rate^(1 / z nu)),
+ * fitted with ln F a polynomial of the given degree in the scaled variable.
+ */
+typedef struct odhs_collapse {
+    size_t size;             /* set by the caller                                   */
+    double phi_j, phi_j_err; /* the jamming packing fraction                        */
+    double y, y_err;         /* the observable's exponent y                         */
+    double znu, znu_err;     /* z nu                                                */
+    double q;                /* y / (z nu): O ~ rate^q at phi_J                      */
+    double chi2;             /* sum of squared, weighted residuals of ln O           */
+    size_t dof;              /* points - polynomial coefficients - 3                 */
+    int degree;              /* the polynomial's degree                             */
+    double coef[8];          /* ln F(x) = sum_k coef[k] ((x - x0) / xs)^k ...        */
+    double x0, xs;           /* ... with the centre and half-width of the data's x   */
+    unsigned evaluations;    /* evaluations of chi2 the minimisation took            */
+} odhs_collapse;
+
+/**
+ * Fit phi_J, y and z nu to n points (phi[k], rate[k] > 0, value[k] > 0)
+ * with relative errors rel_err[k] of the values (NULL: 1 % each): minimise
+ * chi2 = sum_k ((ln value_k - q ln rate_k - P(x_k)) / rel_err_k)^2 over the
+ * three exponents (Nelder-Mead from guess[3] = {phi_J, y, z nu}, or from
+ * {max phi, 1, 3} when NULL, restarted at its minimum), P the weighted
+ * least-squares polynomial of the given degree (1..7) in x_k = (phi_k -
+ * phi_J) / rate_k^(1 / z nu). Errors are the square roots of the diagonal
+ * of 2 H^-1 (H the finite-difference Hessian of chi2 at the minimum),
+ * scaled by chi2/dof when that exceeds 1. Needs n >= degree + 5 points
+ * over at least two rates. Errors: ODHS_E_NULL, ODHS_E_EMPTY (too few
+ * points), ODHS_E_INVALID (a rate, value or error <= 0, degree, size),
+ * ODHS_E_NONFINITE, ODHS_E_NOCONV (no finite minimum: try another guess),
+ * ODHS_E_SINGULAR (flat chi2: an exponent is not determined by the data),
+ * ODHS_E_NOMEM; message in odhs_last_error().
+ */
+ODHS_API int odhs_collapse_fit(const double *phi, const double *rate, const double *value, const double *rel_err,
+                               size_t n, int degree, const double *guess, odhs_collapse *out);
+
 #ifdef __cplusplus
 }
 #endif
