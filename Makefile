@@ -39,6 +39,9 @@
 #   stage           `make install` into build/stage (used by examples)
 #   demo            deps-if-missing, all, examples, run build/examples/shear_flow
 #   bench           build bench/*.c against lib/libodhs.a into build/bench/
+#   python          stage, then build the Python package's cffi extension
+#                   (python/odhs/_cffi*.so) against build/stage with
+#                   pkg-config: PYTHONPATH=python imports odhs
 #   install, uninstall   honour PREFIX, DESTDIR, LIBDIR, INCLUDEDIR
 #   deps, deps-if-missing   install the Debian build dependencies (apt-get)
 #   clean           remove build/, build-asan/, build-allocfail/, build-tsan/,
@@ -601,6 +604,30 @@ demo:
 	./build/examples/shear_flow
 
 # ===========================================================================
+# Python bindings (python/: the odhs package, cffi in API mode)
+# ===========================================================================
+.PHONY: python
+
+# Debian's interpreter: it has the python3-* packages of make deps (a pyenv
+# or virtualenv python3 earlier in PATH may not).
+PYTHON ?= /usr/bin/python3
+# the extension's file name suffix (.cpython-311-x86_64-linux-gnu.so), looked
+# up once when first used
+PY_EXT_SUFFIX = $(eval PY_EXT_SUFFIX := $(shell $(PYTHON) -c \
+    'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))' 2>/dev/null))$(PY_EXT_SUFFIX)
+PY_EXT = python/odhs/_cffi$(PY_EXT_SUFFIX)
+
+# The cffi declarations are generated from the headers (python/odhs_build.py),
+# so the extension is rebuilt when they change; it links the staged library
+# (pkg-config) with an RPATH to it.
+python: stage
+	@$(MAKE) --no-print-directory $(PY_EXT)
+
+$(PY_EXT): python/odhs_build.py $(PUBLIC_HEADERS) $(SHARED_REAL)
+	@mkdir -p build/python
+	PKG_CONFIG_PATH=$(STAGE_PC_PATH) $(PYTHON) python/odhs_build.py --tmpdir build/python
+
+# ===========================================================================
 # Benchmarks (static library; may include internal.h)
 # ===========================================================================
 .PHONY: bench
@@ -708,12 +735,19 @@ fuzz-ci: fuzz
 # lammps (lmp), python3-ase, python3-numpy: tests/examples_cli.sh reads the
 # examples' files with LAMMPS, ASE and numpy (skipped with a message without them).
 # liblammps-dev (LAMMPS's C library interface): examples/lammps_coupling.c.
+# python3-cffi, python3-dev (Python.h: the cffi extension is compiled),
+# python3-numpy, python3-pytest, python3-setuptools, python3-pip,
+# python3-venv, python3-wheel and python3-matplotlib: the Python bindings
+# (make python, make check-python: pytest, pip install into a venv, the
+# examples' plots).
 DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
                  check pkg-config gcc make \
                  clang libclang-rt-14-dev \
                  openmpi-bin libopenmpi-dev \
                  lammps python3-ase python3-numpy \
-                 liblammps-dev
+                 liblammps-dev \
+                 python3-cffi python3-dev python3-pytest python3-setuptools python3-pip \
+                 python3-venv python3-wheel python3-matplotlib
 
 deps:
 	@if [ "$$(id -u)" -eq 0 ]; then SUDO=; else SUDO=sudo; fi; \
@@ -745,6 +779,7 @@ clean:
 	rm -rf build build-asan $(ALLOCFAIL_BUILD)
 	rm -rf $(TSAN_BUILD) $(FUZZ_BUILD)
 	rm -f lib/*.a lib/*.so lib/*.so.*
+	rm -rf python/odhs/_cffi*.so python/build python/odhs.egg-info
 
 # Prints the comment block at the top of this file.
 help:
