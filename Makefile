@@ -3,7 +3,7 @@
 # Main targets (`make help` prints this list):
 #   all (default)   lib/libodhs.a, lib/libodhs.so.X.Y.Z + soname/dev symlinks
 #   check           build and run the Check test runner, plus check-symbols,
-#                   check-readme and check-link
+#                   check-readme, check-link and check-python
 #   check-asan      rebuild library + tests in build-asan/ with ASan/UBSan, run
 #   check-allocfail rebuild in build-allocfail/ with allocation-failure
 #                   injection (-DODHS_FAULT_INJECTION) + ASan/UBSan/LSan and
@@ -42,6 +42,9 @@
 #   python          stage, then build the Python package's cffi extension
 #                   (python/odhs/_cffi*.so) against build/stage with
 #                   pkg-config: PYTHONPATH=python imports odhs
+#   check-python    python, then the pytest suite python/tests (skipped with
+#                   a message when python3-cffi, -numpy, -pytest or the
+#                   Python headers are missing; make deps installs them)
 #   install, uninstall   honour PREFIX, DESTDIR, LIBDIR, INCLUDEDIR
 #   deps, deps-if-missing   install the Debian build dependencies (apt-get)
 #   clean           remove build/, build-asan/, build-allocfail/, build-tsan/,
@@ -379,6 +382,7 @@ $(SHARED_DEVLINK): $(SHARED_SONAME)
 # packages and `make -j check` cannot start compiling before apt-get is done.
 check: deps-if-missing
 	@$(MAKE) --no-print-directory check-symbols check-readme check-run check-link
+	@$(MAKE) --no-print-directory check-python
 
 # Build the runner only.
 tests: $(TEST_RUNNER)
@@ -606,7 +610,7 @@ demo:
 # ===========================================================================
 # Python bindings (python/: the odhs package, cffi in API mode)
 # ===========================================================================
-.PHONY: python
+.PHONY: python check-python
 
 # Debian's interpreter: it has the python3-* packages of make deps (a pyenv
 # or virtualenv python3 earlier in PATH may not).
@@ -617,6 +621,12 @@ PY_EXT_SUFFIX = $(eval PY_EXT_SUFFIX := $(shell $(PYTHON) -c \
     'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))' 2>/dev/null))$(PY_EXT_SUFFIX)
 PY_EXT = python/odhs/_cffi$(PY_EXT_SUFFIX)
 
+# what check-python needs: the interpreter's cffi, numpy, pytest and headers
+PY_CHECK_DEPS := import cffi, numpy, pytest, os, sysconfig; \
+    assert os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")), "Python.h"
+PY_TEST_ENV = OPENBLAS_NUM_THREADS=1 PYTHONPATH=$(CURDIR)/python ODHS_EXAMPLES=$(CURDIR)/build/examples \
+              ODHS_REQUIRE_EXAMPLES=1 ODHS_STAGE=$(STAGE)
+
 # The cffi declarations are generated from the headers (python/odhs_build.py),
 # so the extension is rebuilt when they change; it links the staged library
 # (pkg-config) with an RPATH to it.
@@ -626,6 +636,19 @@ python: stage
 $(PY_EXT): python/odhs_build.py $(PUBLIC_HEADERS) $(SHARED_REAL)
 	@mkdir -p build/python
 	PKG_CONFIG_PATH=$(STAGE_PC_PATH) $(PYTHON) python/odhs_build.py --tmpdir build/python
+
+# The pytest suite: the README's program, the examples shear_flow and minimal
+# compared with the same runs in Python, bad input, callbacks, arrays,
+# ownership, the docs' code blocks, pip install into a venv.
+check-python:
+	@if ! $(PYTHON) -c '$(PY_CHECK_DEPS)' >/dev/null 2>&1; then \
+	    echo "check-python: SKIPPED: $(PYTHON) lacks python3-cffi, python3-numpy, python3-pytest or the Python headers (python3-dev); Debian: make deps"; \
+	else \
+	    $(MAKE) --no-print-directory python && \
+	    $(MAKE) --no-print-directory build/examples/minimal build/examples/shear_flow && \
+	    echo "== running the Python tests (python/tests, $(PYTHON))" && \
+	    $(PY_TEST_ENV) $(PYTHON) -m pytest -q -p no:cacheprovider python/tests; \
+	fi
 
 # ===========================================================================
 # Benchmarks (static library; may include internal.h)

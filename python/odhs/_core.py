@@ -55,6 +55,15 @@ def enc(s, what="string"):
 # ---------------------------------------------------------------------------
 
 
+_live = [0]
+
+
+def live_handles():
+    """How many C objects the bindings own and have not destroyed yet (for
+    leak tests)."""
+    return _live[0]
+
+
 class Handle:
     """One C handle and what it needs kept alive.
 
@@ -73,6 +82,8 @@ class Handle:
     def __init__(self, ptr, destroy, deps=()):
         self.ptr = ptr
         self.destroy = destroy
+        if destroy is not None:
+            _live[0] += 1
         self.deps = []
         self.users = 0
         self.released = False
@@ -101,6 +112,7 @@ class Handle:
         if self.released and self.users == 0 and self.ptr is not None:
             ptr, self.ptr = self.ptr, None
             if self.destroy is not None:
+                _live[0] -= 1
                 self.destroy(ptr)
             deps, self.deps = self.deps, []
             self.keep = {}

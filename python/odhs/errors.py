@@ -87,7 +87,18 @@ class Error(Exception):
     status = None
     status_code = None  # the class's status (set on the subclasses)
 
-    def __init__(self, status, message="", function=""):
+    def __init__(self, *args):
+        """Error(status, message="", function=""), or for a subclass
+        Error(message="", function=""): e.g. a Python solver backend raises
+        odhs.SingularError("pivot 3 is zero")."""
+        if args and isinstance(args[0], int):
+            status, rest = args[0], args[1:]
+        else:
+            status, rest = self.status_code, args
+        if status is None:
+            raise TypeError("odhs.Error(status, message='', function=''): the status is missing")
+        message = rest[0] if rest else ""
+        function = rest[1] if len(rest) > 1 else ""
         self.status = int(status)
         self.status_name = status_name(self.status)
         self.description = strerror(self.status)
@@ -101,8 +112,12 @@ class Error(Exception):
         super().__init__(text)
 
 
+Error.__module__ = "odhs"
+
+
 def _make(name, status, bases, doc):
-    return type(name, (Error,) + bases, {"__doc__": doc, "__module__": __name__, "status_code": status})
+    # shown as odhs.InvalidError (the package exports them)
+    return type(name, (Error,) + bases, {"__doc__": doc, "__module__": "odhs", "status_code": status})
 
 
 NullError = _make("NullError", lib.ODHS_E_NULL, (ValueError,), "ODHS_E_NULL: a required argument was missing.")

@@ -131,12 +131,11 @@ class Trajectory(Owned):
         if p is None:
             return
         self._p = None
-        h = self._h
-        h.ptr = None  # closed here, not by the handle
-        h.release()
-        rc = lib.odhs_traj_close(p)
-        if rc:
-            raise make_error(rc, "writing %s" % self.path, "Trajectory.close")
+        status = []
+        self._h.destroy = lambda ptr: status.append(lib.odhs_traj_close(ptr))
+        self._h.release()  # a trajectory has no dependents: closed now
+        if status and status[0]:
+            raise make_error(status[0], "writing %s" % self.path, "Trajectory.close")
 
 
 def _close_quietly(p):

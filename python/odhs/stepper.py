@@ -101,6 +101,13 @@ class Stepper(Owned):
     def _repr_extra(self):
         return " n=%d dim=%d solver=%r" % (self._n, self._dim, self.solver.name if not self.solver.closed else "?")
 
+    def close(self):
+        """Release the C stepper (a Network view from ``network`` that is
+        still referenced keeps it alive until it goes); the system, driver
+        and solver it kept alive are released with it."""
+        self._network = None
+        super().close()
+
     @property
     def errmsg(self):
         """The message of the last failed call on this stepper ("" if none)."""
