@@ -197,6 +197,8 @@ def out_array(shape, out=None, dtype=F64, what="out"):
     cdata pointer)."""
     if out is None:
         arr = np.empty(shape, dtype=dtype)
+        if dtype is F64:  # the common case, without the table below
+            return arr, ffi.from_buffer("double[]", arr)
     else:
         arr = out
         if not isinstance(arr, np.ndarray) or arr.dtype != dtype or arr.shape != tuple(shape) or \

@@ -255,9 +255,10 @@ class Stepper(Owned):
             st = self._run_result(rc, "Stepper.step")
         else:
             st = _OK
-        if ev.kind == 0:
+        kind = ev.kind
+        if kind == 0:
             return st, None
-        return st, Event(EventKind(ev.kind), ev.i, ev.j, ev.time, ev.strain)
+        return st, Event(_KINDS.get(kind, kind), ev.i, ev.j, ev.time, ev.strain)
 
     def step_ex(self):
         """Take one step and describe it (odhs_stepper_step_ex): returns
@@ -617,6 +618,7 @@ class Stepper(Owned):
 
 
 _OK = _status(0)
+_KINDS = {int(k): k for k in EventKind}
 
 
 def read_checkpoint(path, solver):
