@@ -31,7 +31,6 @@ Used three ways:
 
 import os
 import re
-import shlex
 import shutil
 import subprocess
 import sys

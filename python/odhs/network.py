@@ -8,7 +8,7 @@ methods (valid only during that call). Every array returned is a copy."""
 
 import numpy as np
 
-from ._core import F64, INT, NULL, SIZE_T, Owned, cstr, enc, ffi, in_array, lib, out_array
+from ._core import INT, NULL, SIZE_T, Owned, cstr, enc, ffi, in_array, lib, out_array
 from ._callbacks import check_pending
 from .constants import ContactKind, to_enum
 from .errors import last_error, make_error

@@ -28,7 +28,7 @@ class Softcore(Owned):
         if rc:
             raise make_error(rc, last_error(), "Softcore")
         self._init_handle(out[0], lib.odhs_softcore_destroy, (system._h,))
-        self.system = system
+        self._system = system
         self._n, self._dim = system.n, system.dim
         self._model = SoftcoreModel.RD0
         self._shear_rate = 0.0
@@ -40,6 +40,11 @@ class Softcore(Owned):
         except BaseException:
             self.close()
             raise
+
+    @property
+    def system(self):
+        """The System this handle works on (kept alive by it)."""
+        return self._system
 
     def _err(self, rc, fn):
         p = self._p

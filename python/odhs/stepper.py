@@ -65,9 +65,9 @@ class Stepper(Owned):
 
     def _adopt(self, ptr, system, driver, solver):
         self._init_handle(ptr, lib.odhs_stepper_destroy, (system._h, driver._h, solver._h))
-        self.system = system
-        self.driver = driver
-        self.solver = solver
+        self._system = system
+        self._driver = driver
+        self._solver = solver
         self._event_fn = None
         self._ev = ffi.new("odhs_event *")
         self._info = ffi.new("odhs_step_info *")
@@ -100,6 +100,21 @@ class Stepper(Owned):
 
     def _repr_extra(self):
         return " n=%d dim=%d solver=%r" % (self._n, self._dim, self.solver.name if not self.solver.closed else "?")
+
+    @property
+    def system(self):
+        """The System this stepper moves (kept alive by the stepper)."""
+        return self._system
+
+    @property
+    def driver(self):
+        """The Driver of this stepper (kept alive by the stepper)."""
+        return self._driver
+
+    @property
+    def solver(self):
+        """The Solver of this stepper (kept alive by the stepper)."""
+        return self._solver
 
     def close(self):
         """Release the C stepper (a Network view from ``network`` that is

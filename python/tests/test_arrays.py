@@ -162,3 +162,41 @@ def test_network_build_by_hand(run):
     assert np.array_equal(net.forces, np.arange(net.count))
     net.clear()
     assert net.count == 0 and net.contacts()[0].shape == (0,)
+
+
+def test_step_ex_and_the_remaining_getters(run):
+    s, st = run
+    st2 = odhs.Stepper(s.clone(), odhs.Driver(shear_rate=1.0, mobility=2.0), odhs.Solver("auto"),
+                       integrator="euler", dt=2e-3, correction_interval=5)
+    assert st2.settings == (odhs.Integrator.EULER, 2e-3, 1e-6, 5)
+    st2.tolerance = 1e-7
+    st2.set_contact_tolerance(1e-8)
+    st2.reset()
+    n0 = st2.counts
+    for _ in range(20):
+        status, info = st2.step_ex()
+        assert status == odhs.Status.OK and info.advanced and not info.driver_change
+        assert info.time_end == st2.time and info.strain_end == st2.strain
+        assert info.time_end > info.time_start
+    n1 = st2.counts
+    assert n1.steps - n0.steps == 20
+    assert st2.adaptive_stats.rejected == 0 and st2.rewire_count >= 0
+    assert st2.power == pytest.approx(st2.dissipation, rel=1e-6)
+    assert st2.driver.mobility == 2.0 and st2.driver.time_unit(st2.system) == pytest.approx(1.0)
+    st2.driver.set_kappa_max(50.0)
+    st2.driver.jamming_pressure = 10.0
+    assert st2.driver.jamming_pressure == 10.0
+    assert st2.feature_work("pressure") == 0
+    st2.driver.set_time_unit(0.5)
+    assert st2.driver.time_unit(st2.system) == 0.5
+    st2.driver.clear_time_unit()
+    assert st2.errors.contact_gap < 1e-6
+    assert st2.solver.last_backend[0] in {i.name for i in odhs.available_solvers()} | {"lsq-svd", "lsq-cg"}
+    st2.solver.set_check_tolerance(1e-6)
+    st2.solver.set_refinement(2)
+    net = odhs.Network(s)
+    net.detect(s, 0.0)
+    net.add_bond(0, 1, 2.0)
+    k = net.find(0, 1)
+    assert net.rest_length(k, s) == 2.0 and net.contact(k)[2] == odhs.ContactKind.PERMANENT
+    assert net.coordination == pytest.approx(2 * net.count / s.n)

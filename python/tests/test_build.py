@@ -84,10 +84,6 @@ def test_pip_install_into_a_venv(tmp_path):
         if os.environ.get("ODHS_REQUIRE_EXAMPLES") == "1":
             pytest.fail(msg)
         pytest.skip(msg)
-    try:
-        import ensurepip  # noqa: F401  (python3-venv)
-    except ImportError:
-        pytest.skip("python3-venv is not installed")
     src = tmp_path / "src"
     shutil.copytree(PYDIR, src, ignore=shutil.ignore_patterns("_cffi*.so", "build", "*.egg-info", "__pycache__",
                                                               "tests", "bench", "examples", ".pytest_cache"))
@@ -115,3 +111,40 @@ def test_pip_install_into_a_venv(tmp_path):
     assert where.startswith(str(venv))  # the installed package, not the tree
     assert os.path.realpath(libpath).startswith(os.path.realpath(stage))  # found through its RPATH
     assert line == "success: sigma = 0.0183684  p = 0.025222  z = 0.5"
+
+
+def test_every_public_name_is_documented():
+    """Every public class, function, method and property of odhs has a
+    docstring."""
+    import inspect
+
+    missing = []
+    for name in odhs.__all__:
+        obj = getattr(odhs, name)
+        if not (inspect.isclass(obj) or inspect.isfunction(obj)):
+            continue
+        if not inspect.getdoc(obj):
+            missing.append(name)
+        if not inspect.isclass(obj) or issubclass(obj, (tuple, int)) and not issubclass(obj, odhs.Status):
+            continue  # records (named tuples) and enums: their fields are data
+        for attr, member in vars(obj).items():
+            if attr.startswith("_"):
+                continue
+            if inspect.isfunction(member) or isinstance(member, (property, classmethod, staticmethod)):
+                doc = member.__doc__ if not isinstance(member, (classmethod, staticmethod)) else \
+                    member.__func__.__doc__
+                if not doc:
+                    missing.append("%s.%s" % (name, attr))
+    assert not missing, "no docstring: %s" % missing
+
+
+def test_package_names_only_bound_functions():
+    """Every lib.<name> the package uses exists (a typo would fail only when
+    its method is called)."""
+    used = set()
+    pkg = os.path.join(PYDIR, "odhs")
+    for fn in os.listdir(pkg):
+        if fn.endswith(".py"):
+            used |= set(re.findall(r"\blib\.(\w+)", open(os.path.join(pkg, fn), encoding="utf-8").read()))
+    assert len(used) > 200
+    assert not sorted(used - set(dir(lib)))

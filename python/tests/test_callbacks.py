@@ -295,3 +295,37 @@ def test_solver_solve_direct_call():
     g = np.random.default_rng(0).normal(size=(s.n, 2))
     xl = odhs.Solver("dense").solve_ls(net, g)
     np.testing.assert_allclose(net.apply_N(xl), net.apply_S(g), rtol=1e-8, atol=1e-10)
+
+
+def test_callback_exceptions_stay_in_their_thread():
+    """Two steppers in two threads (cffi releases the GIL during the C
+    calls): an exception raised in one thread's callback is raised in that
+    thread only."""
+    import threading
+
+    results = {}
+
+    def work(name, fail):
+        st = sheared(seed=5 if fail else 6)
+        n = [0]
+
+        def cb(ev):
+            n[0] += 1
+            if fail and n[0] == 5:
+                raise ArithmeticError("thread %s" % name)
+
+        st.set_event_callback(cb)
+        try:
+            for g in np.linspace(0.05, 0.5, 10):
+                st.run_until_strain(g)
+            results[name] = ("ok", n[0])
+        except ArithmeticError as e:
+            results[name] = ("raised", str(e))
+
+    threads = [threading.Thread(target=work, args=("a", True)), threading.Thread(target=work, args=("b", False))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert results["a"] == ("raised", "thread a")
+    assert results["b"][0] == "ok" and results["b"][1] > 5
