@@ -259,7 +259,17 @@ def main(argv):
     ap.add_argument("--tmpdir", default=None, help="where the generated C file and objects go")
     ap.add_argument("--print-cdef", action="store_true", help="print the generated cdef and exit")
     args = ap.parse_args(argv)
-    where = find_odhs()
+    import importlib.util
+
+    if importlib.util.find_spec("cffi") is None:
+        sys.stderr.write("odhs_build: %s has no cffi (Debian: apt-get install python3-cffi python3-dev, or "
+                         "make deps)\n" % sys.executable)
+        return 1
+    try:
+        where = find_odhs()
+    except LibraryNotFound as e:
+        sys.stderr.write("odhs_build: %s\n" % e)
+        return 1
     if args.print_cdef:
         sys.stdout.write(generate_cdef(where["include_dir"]))
         return 0
