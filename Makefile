@@ -3,7 +3,7 @@
 # Main targets (`make help` prints this list):
 #   all (default)   lib/libodhs.a, lib/libodhs.so.X.Y.Z + soname/dev symlinks
 #   check           build and run the Check test runner, plus check-symbols,
-#                   check-readme and check-link
+#                   check-readme, check-link and check-python
 #   check-asan      rebuild library + tests in build-asan/ with ASan/UBSan, run
 #   check-allocfail rebuild in build-allocfail/ with allocation-failure
 #                   injection (-DODHS_FAULT_INJECTION) + ASan/UBSan/LSan and
@@ -39,6 +39,12 @@
 #   stage           `make install` into build/stage (used by examples)
 #   demo            deps-if-missing, all, examples, run build/examples/shear_flow
 #   bench           build bench/*.c against lib/libodhs.a into build/bench/
+#   python          stage, then build the Python package's cffi extension
+#                   (python/odhs/_cffi*.so) against build/stage with
+#                   pkg-config: PYTHONPATH=python imports odhs
+#   check-python    python, then the pytest suite python/tests (skipped with
+#                   a message when python3-cffi, -numpy, -pytest or the
+#                   Python headers are missing; make deps installs them)
 #   install, uninstall   honour PREFIX, DESTDIR, LIBDIR, INCLUDEDIR
 #   deps, deps-if-missing   install the Debian build dependencies (apt-get)
 #   clean           remove build/, build-asan/, build-allocfail/, build-tsan/,
@@ -376,6 +382,7 @@ $(SHARED_DEVLINK): $(SHARED_SONAME)
 # packages and `make -j check` cannot start compiling before apt-get is done.
 check: deps-if-missing
 	@$(MAKE) --no-print-directory check-symbols check-readme check-run check-link
+	@$(MAKE) --no-print-directory check-python
 
 # Build the runner only.
 tests: $(TEST_RUNNER)
@@ -601,6 +608,49 @@ demo:
 	./build/examples/shear_flow
 
 # ===========================================================================
+# Python bindings (python/: the odhs package, cffi in API mode)
+# ===========================================================================
+.PHONY: python check-python
+
+# Debian's interpreter: it has the python3-* packages of make deps (a pyenv
+# or virtualenv python3 earlier in PATH may not).
+PYTHON ?= /usr/bin/python3
+# the extension's file name suffix (.cpython-311-x86_64-linux-gnu.so), looked
+# up once when first used
+PY_EXT_SUFFIX = $(eval PY_EXT_SUFFIX := $(shell $(PYTHON) -c \
+    'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))' 2>/dev/null))$(PY_EXT_SUFFIX)
+PY_EXT = python/odhs/_cffi$(PY_EXT_SUFFIX)
+
+# what check-python needs: the interpreter's cffi, numpy, pytest and headers
+PY_CHECK_DEPS := import cffi, numpy, pytest, os, sysconfig; \
+    assert os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")), "Python.h"
+PY_TEST_ENV = OPENBLAS_NUM_THREADS=1 PYTHONPATH=$(CURDIR)/python ODHS_EXAMPLES=$(CURDIR)/build/examples \
+              ODHS_REQUIRE_EXAMPLES=1 ODHS_STAGE=$(STAGE)
+
+# The cffi declarations are generated from the headers (python/odhs_build.py),
+# so the extension is rebuilt when they change; it links the staged library
+# (pkg-config) with an RPATH to it.
+python: stage
+	@$(MAKE) --no-print-directory $(PY_EXT)
+
+$(PY_EXT): python/odhs_build.py $(PUBLIC_HEADERS) $(SHARED_REAL)
+	@mkdir -p build/python
+	PKG_CONFIG_PATH=$(STAGE_PC_PATH) $(PYTHON) python/odhs_build.py --tmpdir build/python
+
+# The pytest suite: the README's program, the examples shear_flow and minimal
+# compared with the same runs in Python, bad input, callbacks, arrays,
+# ownership, the docs' code blocks, pip install into a venv.
+check-python:
+	@if ! $(PYTHON) -c '$(PY_CHECK_DEPS)' >/dev/null 2>&1; then \
+	    echo "check-python: SKIPPED: $(PYTHON) lacks python3-cffi, python3-numpy, python3-pytest or the Python headers (python3-dev); Debian: make deps"; \
+	else \
+	    $(MAKE) --no-print-directory python && \
+	    $(MAKE) --no-print-directory build/examples/minimal build/examples/shear_flow && \
+	    echo "== running the Python tests (python/tests, $(PYTHON))" && \
+	    $(PY_TEST_ENV) $(PYTHON) -m pytest -q -p no:cacheprovider python/tests; \
+	fi
+
+# ===========================================================================
 # Benchmarks (static library; may include internal.h)
 # ===========================================================================
 .PHONY: bench
@@ -708,12 +758,19 @@ fuzz-ci: fuzz
 # lammps (lmp), python3-ase, python3-numpy: tests/examples_cli.sh reads the
 # examples' files with LAMMPS, ASE and numpy (skipped with a message without them).
 # liblammps-dev (LAMMPS's C library interface): examples/lammps_coupling.c.
+# python3-cffi, python3-dev (Python.h: the cffi extension is compiled),
+# python3-numpy, python3-pytest, python3-setuptools, python3-pip,
+# python3-venv, python3-wheel and python3-matplotlib: the Python bindings
+# (make python, make check-python: pytest, pip install into a venv, the
+# examples' plots).
 DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
                  check pkg-config gcc make \
                  clang libclang-rt-14-dev \
                  openmpi-bin libopenmpi-dev \
                  lammps python3-ase python3-numpy \
-                 liblammps-dev
+                 liblammps-dev \
+                 python3-cffi python3-dev python3-pytest python3-setuptools python3-pip \
+                 python3-venv python3-wheel python3-matplotlib
 
 deps:
 	@if [ "$$(id -u)" -eq 0 ]; then SUDO=; else SUDO=sudo; fi; \
@@ -745,6 +802,7 @@ clean:
 	rm -rf build build-asan $(ALLOCFAIL_BUILD)
 	rm -rf $(TSAN_BUILD) $(FUZZ_BUILD)
 	rm -f lib/*.a lib/*.so lib/*.so.*
+	rm -rf python/odhs/_cffi*.so python/build python/odhs.egg-info
 
 # Prints the comment block at the top of this file.
 help:
