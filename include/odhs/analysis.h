@@ -56,8 +56,9 @@ typedef struct odhs_series_stats {
  * averaging neighbours again and again; the error of the mean estimated
  * from blocks of length 2^k grows with k while blocks are correlated and
  * levels off once they are not. The plateau is the first level k whose
- * estimate agrees with those of the next two levels within its own
- * uncertainty, keeping at least 8 blocks. tau_int from the normalised
+ * estimate agrees with the next level's within that one's uncertainty and
+ * with the level after within twice its uncertainty, keeping at least 8
+ * blocks. tau_int from the normalised
  * autocorrelation with Sokal's automatic window. Both errors are given:
  * they agree for long series (tested on AR(1) processes). Allocates O(n).
  * Errors: ODHS_E_NULL, ODHS_E_EMPTY (n < 4), ODHS_E_NONFINITE,

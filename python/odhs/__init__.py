@@ -5,7 +5,8 @@ The classes mirror the C handles: System (odhs_system), Driver
 (odhs_driver), Solver (odhs_solver; SolverBackend for backends written in
 Python), Stepper (odhs_stepper, with walls, composites, the jamming
 certificate and checkpoints), Network (odhs_network), Softcore
-(odhs_softcore) and Trajectory (odhs_traj). Arrays go in and out as numpy
+(odhs_softcore) and Trajectory (odhs_traj); odhs.analysis holds the
+analysis calls (analysis.h). Arrays go in and out as numpy
 float64 arrays of shape (n, dim), (n,) or (Nc,); errors are raised as
 odhs.Error subclasses named after the status (InvalidError for
 ODHS_E_INVALID, ...), carrying the status and the handle's message. See
@@ -20,6 +21,7 @@ docs/python.md for the tutorial.
         print(st.shear_stress, st.pressure, st.coordination)
 """
 
+from . import analysis
 from ._core import HEADER_VERSION, LIBRARY_VERSION, ffi, lib
 from .constants import (ContactKind, EventKind, Feature, Integrator, Minimiser, Oscillation, SoftcoreIntegrator,
                         SoftcoreModel, SolverFlag, StressPart, TrajFormat, WallShape)

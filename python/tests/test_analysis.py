@@ -1,0 +1,86 @@
+"""The analysis calls (odhs.analysis over analysis.h) against the C results
+and analytic cases: series statistics of an AR(1) process, a histogram,
+a power-law exponent, backbone forces and gaps of a jammed packing against
+its certificate, g_y of a cosine field on a lattice, a scaling collapse of
+synthetic flow curves, and errors raised with their messages."""
+
+import numpy as np
+import pytest
+
+import odhs
+from odhs import analysis
+
+
+def test_series_stats_ar1():
+    rng = np.random.default_rng(1)
+    p, n = 0.9, 1 << 16
+    e = rng.standard_normal(n)
+    x = np.empty(n)
+    x[0] = e[0] / np.sqrt(1 - p * p)
+    for t in range(1, n):
+        x[t] = p * x[t - 1] + e[t]
+    s = analysis.series_stats(x)
+    tau = 0.5 * (1 + p) / (1 - p)
+    assert s.n == n and s.plateau
+    assert abs(s.tau_int / tau - 1) < 0.15
+    assert abs(s.mean - x.mean()) < 1e-12 and abs(s.variance - x.var(ddof=1)) < 1e-9
+    rho = analysis.autocorrelation(x, 5)
+    assert rho.shape == (6,) and rho[0] == 1.0 and abs(rho[1] - p) < 0.02
+
+
+def test_histogram_and_power_law():
+    rng = np.random.default_rng(2)
+    x = rng.random(100000) ** (1 / 1.4)  # p(x) = 1.4 x^0.4 on (0, 1]
+    h = analysis.histogram(x, 0.0, 1.0, 10)
+    assert h.edges.shape == (11,) and h.density.shape == (10,) and h.counts.dtype == np.uint64
+    assert h.outside == 0 and int(h.counts.sum()) == x.size
+    assert abs(np.sum(h.density * np.diff(h.edges)) - 1) < 1e-12
+    pl = analysis.power_law_exponent(x, 0.5)
+    assert abs(pl.exponent - 0.4) < 4 * pl.error and pl.used == int(np.sum(x <= 0.5))
+    with pytest.raises(odhs.InvalidError) as e:
+        analysis.histogram(x, 1.0, 1.0, 4)
+    assert "range" in e.value.message
+
+
+def test_backbone_and_gaps_of_a_jammed_packing():
+    s = odhs.System(2, 64)
+    s.set_radii_bidisperse(0.5, 1.4, 0.0, 5)
+    s.place_random(0.5, 5)
+    st = odhs.Stepper(s, odhs.Driver(compression_rate=1.0), odhs.Solver("cholmod"))
+    rc = st.run_until_packing_fraction(0.9)
+    assert rc == odhs.Status.JAMMED
+    cert = st.certificate()
+    f = analysis.backbone_forces(st.network)
+    assert f.shape == (cert.n_contacts_backbone,) and np.all(f > 0)
+    g = analysis.packing_gaps(s, st.network, 0.2)
+    assert len(g.i) == len(g.gap) > 0 and np.all(g.i < g.j) and np.all(g.gap <= 0.2)
+    assert set(np.unique(g.role)) <= {0, 1, 2}
+
+
+def test_velocity_correlation_cosine():
+    nx, ny = 16, 8
+    s = odhs.System(2, nx * ny)
+    xy = np.array([[b + 0.5, a + 0.5] for a in range(ny) for b in range(nx)])
+    s.set_configuration([nx, ny], 0.0, np.full(nx * ny, 0.3), xy)
+    v = np.zeros_like(xy)
+    v[:, 1] = np.cos(2 * np.pi * xy[:, 0] / nx)
+    g, pairs = analysis.velocity_correlation(s, v, 0.5, 9)
+    assert np.isnan(g[8]) and pairs[8] == 0
+    assert np.allclose(g[:8], np.cos(2 * np.pi * np.arange(8) / nx), atol=1e-12)
+    x, gmin = analysis.correlation_minimum((np.arange(10) + 0.5 - 3.3) ** 2 - 0.2)
+    assert abs(x - 3.3) < 1e-12 and abs(gmin + 0.2) < 1e-12
+
+
+def test_collapse_fit():
+    rng = np.random.default_rng(7)
+    phi = np.tile(0.83 + 0.003 * np.arange(11), 4)
+    rate = np.repeat([1e-7, 1e-6, 1e-5, 1e-4], 11)
+    x = (phi - 0.8433) / rate ** (1 / 3.5)
+    val = rate ** (1.1 / 3.5) * np.exp(0.3 + 1.2 * x - 0.1 * x ** 2 + 0.02 * x ** 3) * (1 + 0.01 *
+                                                                                         rng.standard_normal(44))
+    c = analysis.collapse_fit(phi, rate, val, np.full(44, 0.01), degree=3, guess=(0.84, 1.0, 3.0))
+    assert abs(c.phi_j - 0.8433) < 3.5 * c.phi_j_err and abs(c.y - 1.1) < 3.5 * c.y_err
+    assert abs(c.znu - 3.5) < 3.5 * c.znu_err and c.coef.shape == (4,) and c.dof == 44 - 7
+    with pytest.raises(odhs.EmptyError) as e:
+        analysis.collapse_fit(phi[:11], rate[:11], val[:11])
+    assert "same rate" in e.value.message
