@@ -803,6 +803,8 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
         int s = odhs_stepper_step_ex(f->st, &in);
         size_t nc;
         if (s >= 0) s = odhs_stepper_contacts(f->st, 256, &nc, f->ci, f->cj, NULL, f->cf, NULL);
+        double pre[4];
+        if (s >= 0 && in.advanced) s = odhs_stepper_pre_event_stress(f->st, pre);
         return s;
     }
     switch (k) {
@@ -838,7 +840,12 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
     case 5:
         return odhs_stepper_set_integrator(f->st, v == 1 || v == 3 || v == 5 || v == 6 ? ODHS_INTEGRATOR_HEUN
                                                                              : ODHS_INTEGRATOR_EULER);
-    case 6: return odhs_stepper_set_contact_tolerance(f->st, 1e-2);
+    case 6: {
+        int s = odhs_stepper_set_contact_tolerance(f->st, 1e-2);
+        /* 6: and the pre-event stress record of 0.2.8 (its own arrays) */
+        if (!s && v == 6) s = odhs_stepper_set_pre_event_stress(f->st, 1);
+        return s;
+    }
     case SH_FORCES: {
         double F[64];
         memset(F, 0, sizeof F);

@@ -106,6 +106,41 @@ START_TEST(test_series_short)
 }
 END_TEST
 
+START_TEST(test_event_split)
+{
+    /* an exact sawtooth: the signal falls by 0.1 per step, events at steps
+     * 2, 3 and 7 raise it by 1, 2 and 3; step 5 (unmarked) by 0.5 */
+    const size_t n = 9;
+    double before[9], after[9], v = 10.0;
+    unsigned char ev[9] = {0, 0, 1, 1, 0, 0, 0, 1, 0};
+    const double up[9] = {0, 0, 1, 2, 0, 0.5, 0, 3, 0};
+    for (size_t k = 0; k < n; ++k) {
+        v -= 0.1;
+        before[k] = v;
+        v += up[k];
+        after[k] = v;
+    }
+    double jumps[9], drops[9];
+    size_t nj = 99, nd = 99;
+    ck_assert_int_eq(odhs_series_event_split(before, after, ev, n, jumps, &nj, drops, &nd), ODHS_OK);
+    ck_assert(nj == 3 && nd == 2);
+    const double ej[3] = {1, 2, 3}, ed[2] = {0.1, 4 * 0.1 - 0.5};
+    for (int m = 0; m < 3; ++m) ck_assert_msg(fabs(jumps[m] - ej[m]) < 1e-12, "jump %d = %g", m, jumps[m]);
+    for (int m = 0; m < 2; ++m) ck_assert_msg(fabs(drops[m] - ed[m]) < 1e-12, "drop %d = %g", m, drops[m]);
+    /* the signal's change from after the first event to after the last is
+     * the later jumps minus the drops */
+    ck_assert(fabs((after[7] - after[2]) - (jumps[1] + jumps[2] - drops[0] - drops[1])) < 1e-12);
+    /* counts only; no marked step; one marked step */
+    ck_assert_int_eq(odhs_series_event_split(before, after, ev, n, NULL, &nj, NULL, &nd), ODHS_OK);
+    ck_assert(nj == 3 && nd == 2);
+    unsigned char none[9] = {0}, one[9] = {0, 0, 0, 0, 1, 0, 0, 0, 0};
+    ck_assert_int_eq(odhs_series_event_split(before, after, none, n, jumps, &nj, drops, &nd), ODHS_OK);
+    ck_assert(nj == 0 && nd == 0);
+    ck_assert_int_eq(odhs_series_event_split(before, after, one, n, jumps, &nj, drops, &nd), ODHS_OK);
+    ck_assert(nj == 1 && nd == 0 && fabs(jumps[0]) < 1e-15);
+}
+END_TEST
+
 START_TEST(test_histogram)
 {
     tu_rng r;
@@ -436,6 +471,7 @@ Suite *make_analysis_suite(void)
     tcase_add_test(tc, test_series_ar1);
     tcase_add_test(tc, test_series_short);
     tcase_add_test(tc, test_histogram);
+    tcase_add_test(tc, test_event_split);
     tcase_add_test(tc, test_power_law);
     tcase_add_test(tc, test_backbone_by_hand);
     tcase_add_test(tc, test_jammed_packing);

@@ -2294,7 +2294,25 @@ static int traj_status(odhs_traj *tr, int rc)
     X(net_get_contacts_null, odhs_network_get_contacts, ODHS_E_NULL, NOALT, H_NONE, 0,                         \
       size_t i[4]; return odhs_network_get_contacts(NULL, i, NULL, NULL);)                                     \
     X(net_get_contacts_no_out, odhs_network_get_contacts, ODHS_E_NULL, NOALT, H_NET2, 0,                       \
-      return odhs_network_get_contacts(w->net2, NULL, NULL, NULL);)
+      return odhs_network_get_contacts(w->net2, NULL, NULL, NULL);)                                            \
+    X(st_set_pre_event_null, odhs_stepper_set_pre_event_stress, ODHS_E_NULL, NOALT, H_NONE, 0,                 \
+      return odhs_stepper_set_pre_event_stress(NULL, 1);)                                                      \
+    X(st_set_pre_event_two, odhs_stepper_set_pre_event_stress, ODHS_E_INVALID, NOALT, H_RUN, 0,                \
+      return odhs_stepper_set_pre_event_stress(w->run, 2);)                                                    \
+    X(st_pre_event_null, odhs_stepper_pre_event_stress, ODHS_E_NULL, NOALT, H_NONE, 0,                         \
+      double sg[9]; return odhs_stepper_pre_event_stress(NULL, sg);)                                           \
+    X(st_pre_event_null_out, odhs_stepper_pre_event_stress, ODHS_E_NULL, NOALT, H_RUN, 0,                      \
+      return odhs_stepper_pre_event_stress(w->run, NULL);)                                                     \
+    X(st_pre_event_off, odhs_stepper_pre_event_stress, ODHS_E_STATE, NOALT, H_RUN, 0,                          \
+      double sg[9]; return odhs_stepper_pre_event_stress(w->run, sg);)                                         \
+    X(an_split_null, odhs_series_event_split, ODHS_E_NULL, NOALT, H_NONE, 0,                                   \
+      double b[2] = {1, 2}; size_t nj, nd; return odhs_series_event_split(b, NULL, NULL, 2, NULL, &nj, NULL, &nd);) \
+    X(an_split_empty, odhs_series_event_split, ODHS_E_EMPTY, NOALT, H_NONE, 0,                                 \
+      double b[2] = {1, 2}; unsigned char e[2] = {1, 1}; size_t nj, nd;                                       \
+      return odhs_series_event_split(b, b, e, 0, NULL, &nj, NULL, &nd);)                                       \
+    X(an_split_nan, odhs_series_event_split, ODHS_E_NONFINITE, NOALT, H_NONE, 0,                               \
+      double b[2] = {1, 2}, a[2] = {NAN_, 2}; unsigned char e[2] = {1, 1}; size_t nj, nd;                     \
+      return odhs_series_event_split(b, a, e, 2, NULL, &nj, NULL, &nd);)
 
 #define REGRESSION_CASES(X)                                                                             \
     X(reg_wrap_far_positions, odhs_system_set_configuration, ODHS_OK, NOALT, H_NONE, F_NOPROBE,                \

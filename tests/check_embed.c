@@ -20,6 +20,11 @@
  *     positions (and with Heun at the predictor): a pure function works.
  *  9. a system changed behind the stepper's back is refused until reset.
  * 10. bulk contacts and external forces equal the one-at-a-time calls.
+ * 11. the pre-event stress (0.2.8): a run is bit-identical with and without
+ *     the record; without events the record equals the stress after the
+ *     step; at fixed volume the shear stress never jumps down at a
+ *     collision (a new constraint cannot lower the least dissipation), and
+ *     jumps up at most of them; states without a record say why.
  *
  * Copyright (C) 2026 the libodhs authors. LGPL-2.1-or-later, see LICENSE.
  */
@@ -603,6 +608,85 @@ START_TEST(test_bulk_contacts)
 }
 END_TEST
 
+/* ---- 11. the pre-event stress ---------------------------------------------- */
+START_TEST(test_pre_event_stress)
+{
+    odhs_system *base = scene(64, 0.80, 0, 3);
+    odhs_system *copy = NULL;
+    ck_assert_int_eq(odhs_system_clone(base, &copy), ODHS_OK);
+    rig a = rig_new(base), b = rig_new(copy);
+    rig *rs[2] = {&a, &b};
+    for (int k = 0; k < 2; ++k) {
+        ck_assert_int_eq(odhs_driver_set_shear_rate(rs[k]->drv, 1.0), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_integrator(rs[k]->st, ODHS_INTEGRATOR_EULER), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_dt(rs[k]->st, 1e-3), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_correction_interval(rs[k]->st, 0), ODHS_OK);
+    }
+    double sig[4], pre[4], prev[4];
+    /* off: no record, and the reason */
+    ck_assert_int_eq(odhs_stepper_pre_event_stress(a.st, pre), ODHS_E_STATE);
+    ck_assert_msg(strstr(odhs_stepper_errmsg(a.st), "not recorded"), "%s", odhs_stepper_errmsg(a.st));
+    ck_assert_int_eq(odhs_stepper_set_pre_event_stress(a.st, 2), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_stepper_set_pre_event_stress(a.st, 1), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_pre_event_stress(a.st, pre), ODHS_E_STATE);
+    ck_assert_msg(strstr(odhs_stepper_errmsg(a.st), "no step taken"), "%s", odhs_stepper_errmsg(a.st));
+    ck_assert_int_eq(odhs_stepper_reset(a.st), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_stress(a.st, prev), ODHS_OK);
+    size_t quiet = 0, colls = 0, up = 0;
+    double worst_quiet = 0.0, worst_down = 0.0, scale = 0.0;
+    for (int step = 0; step < 600; ++step) {
+        odhs_step_info ia = {.size = sizeof ia}, ib = {.size = sizeof ib};
+        ck_assert_int_eq(odhs_stepper_step_ex(a.st, &ia), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_step_ex(b.st, &ib), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_stress(a.st, sig), ODHS_OK);
+        ck_assert_msg(odhs_stepper_pre_event_stress(a.st, pre) == ODHS_OK, "step %d: %s", step,
+                      odhs_stepper_errmsg(a.st));
+        scale = fmax(scale, fabs(sig[1]));
+        if (ia.collisions == 0 && ia.openings == 0) {
+            /* same network, same geometry: the same solve */
+            quiet++;
+            for (int c = 0; c < 4; ++c) worst_quiet = fmax(worst_quiet, fabs(sig[c] - pre[c]));
+        } else if (ia.openings == 0) {
+            colls++;
+            double jump = sig[1] - pre[1];
+            if (jump > 1e-6 * fabs(sig[1])) up++;
+            worst_down = fmax(worst_down, -jump / fabs(sig[1]));
+        }
+        /* the continuous part moves the stress from the last step's value */
+        ck_assert_msg(pre[1] != prev[1] || !ia.advanced, "step %d: the record is the start's stress", step);
+        memcpy(prev, sig, sizeof prev);
+    }
+    ck_assert_msg(quiet > 50 && colls > 50, "%zu steps without events, %zu collision steps", quiet, colls);
+    ck_assert_msg(worst_quiet == 0.0, "record and stress differ by %g on steps without events", worst_quiet);
+    ck_assert_msg(worst_down < 1e-9, "the shear stress fell by %g (relative) at a collision", worst_down);
+    ck_assert_msg(up > colls / 2, "only %zu of %zu collisions raised the stress", up, colls);
+    /* the record changes nothing else (cholmod keeps no state) */
+    double xa[128], xb[128], sb[4];
+    ck_assert_int_eq(odhs_system_get_positions(a.sys, xa), ODHS_OK);
+    ck_assert_int_eq(odhs_system_get_positions(b.sys, xb), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_stress(b.st, sb), ODHS_OK);
+    ck_assert_msg(memcmp(xa, xb, sizeof xa) == 0 && memcmp(sig, sb, sizeof sb) == 0,
+                  "a run with the record differs from one without");
+    /* a driver change with no motion has no record; pressure control none */
+    ck_assert_int_eq(odhs_driver_set_shear_rate(a.drv, 2.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_step(a.st, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_pressure(a.drv, 10.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_step(a.st, NULL), ODHS_OK);
+    int s = odhs_stepper_pre_event_stress(a.st, pre);
+    ck_assert_msg(s == ODHS_E_STATE && (strstr(odhs_stepper_errmsg(a.st), "pressure") ||
+                                        strstr(odhs_stepper_errmsg(a.st), "driver")),
+                  "%d: %s", s, odhs_stepper_errmsg(a.st));
+    /* switching off clears it */
+    ck_assert_int_eq(odhs_stepper_set_pre_event_stress(a.st, 0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_pre_event_stress(a.st, pre), ODHS_E_STATE);
+    ck_assert_int_eq(odhs_stepper_pre_event_stress(NULL, pre), ODHS_E_NULL);
+    ck_assert_int_eq(odhs_stepper_pre_event_stress(a.st, NULL), ODHS_E_NULL);
+    ck_assert_int_eq(odhs_stepper_set_pre_event_stress(NULL, 1), ODHS_E_NULL);
+    rig_free(&a);
+    rig_free(&b);
+}
+END_TEST
+
 Suite *make_embed_suite(void)
 {
     Suite *s = suite_create("embed");
@@ -621,6 +705,7 @@ Suite *make_embed_suite(void)
     tcase_add_test(tc, test_step_info_size);
     tcase_add_test(tc, test_system_changed);
     tcase_add_test(tc, test_bulk_contacts);
+    tcase_add_test(tc, test_pre_event_stress);
     suite_add_tcase(s, tc);
     return s;
 }

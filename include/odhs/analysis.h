@@ -75,6 +75,27 @@ ODHS_API int odhs_series_stats_compute(const double *x, size_t n, odhs_series_st
  */
 ODHS_API int odhs_series_autocorrelation(const double *x, size_t n, size_t maxlag, double *rho);
 
+/**
+ * Split an event-resolved signal into its jumps at events and its changes
+ * between them (the paper's Fig. 4: the stress relaxes while a network
+ * lasts and jumps up at collisions). Per step k = 0..n-1: before[k], the
+ * value at the end of the step's motion before its events (e.g. a component
+ * of odhs_stepper_pre_event_stress), after[k], the value after them
+ * (odhs_stepper_stress), and at_event[k] nonzero for the steps to split at
+ * (e.g. odhs_step_info.collisions > 0). Writes, in step order:
+ *  - jumps[m] = after[k] - before[k] at the m-th marked step (*njumps of them);
+ *  - drops[m] = after[k_m] - before[k_{m+1}] between the m-th and the next
+ *    marked step: how far the signal fell from just after one event to just
+ *    before the next (negative if it rose), including the changes at the
+ *    unmarked steps between (*ndrops = *njumps - 1, or 0).
+ * jumps and drops (room for n values) may be NULL to count only.
+ * Errors: ODHS_E_NULL (before, after, at_event, njumps or ndrops NULL),
+ * ODHS_E_EMPTY (n = 0), ODHS_E_NONFINITE; message in odhs_last_error().
+ * Since 0.2.8.
+ */
+ODHS_API int odhs_series_event_split(const double *before, const double *after, const unsigned char *at_event,
+                                     size_t n, double *jumps, size_t *njumps, double *drops, size_t *ndrops);
+
 /* ---- distributions --------------------------------------------------------- */
 
 /**

@@ -245,6 +245,38 @@ ODHS_API int odhs_stepper_counts(const odhs_stepper *st, uint64_t *steps, uint64
  *  eq. 30 generalised, positive shear stress sigma_xy under positive shear),
  *  over particle contacts and bonds (wall forces: odhs_stepper_wall_force). */
 ODHS_API int odhs_stepper_stress(const odhs_stepper *st, double *sigma);
+/**
+ * Record the stress just before each step's events (on = 1) or not (on = 0,
+ * the default; other values: ODHS_E_INVALID). The stress of a hard-sphere
+ * network changes continuously while the network lasts and jumps where it
+ * changes (a collision; the rewiring after it); this record separates the
+ * two: with it on, every step also solves the forces of its end
+ * configuration on the network of its start (one more force solve per step),
+ * so that for each step
+ *     odhs_stepper_pre_event_stress - the stress before the step
+ * is the continuous change during the step, and
+ *     odhs_stepper_stress - odhs_stepper_pre_event_stress
+ * the jump at its end (its collisions, openings and drift correction). The
+ * paper's Fig. 4 signal (relaxation between collisions, upward jumps at
+ * them) is this pair of values. The record changes no other result: with a
+ * stateless solver (dense, cholmod, spqr) a run is bit-identical with and
+ * without it; solvers that keep state between solves (cg warm starts,
+ * cholmod-pcg, auto's choices) may differ within their tolerance. Not
+ * recorded under pressure control. Switching changes nothing else and
+ * clears the record. Since 0.2.8.
+ */
+ODHS_API int odhs_stepper_set_pre_event_stress(odhs_stepper *st, int on);
+/**
+ * The stress tensor (dim*dim, as odhs_stepper_stress) at the end of the last
+ * step's motion, on the network of its start: the left limit of the stress
+ * at the step's events. ODHS_E_STATE (with the reason in the message) when
+ * there is no record: recording off, no step since it was switched on or
+ * since odhs_stepper_reset, the last step only applied a change of the
+ * driver (no motion), pressure control, or the solve on the start network
+ * failed (e.g. a network that became potentially jammed). A failed step
+ * leaves the previous record. Since 0.2.8.
+ */
+ODHS_API int odhs_stepper_pre_event_stress(const odhs_stepper *st, double *sigma);
 /** Shear stress sigma_xy. */
 ODHS_API int odhs_stepper_shear_stress(const odhs_stepper *st, double *sigma_xy);
 /** Pressure p = <f|r>/(Omega d) (eq. 24). */

@@ -47,6 +47,32 @@ static void autocorr(const double *x, size_t n, double m, size_t maxlag, double 
     }
 }
 
+int odhs_series_event_split(const double *before, const double *after, const unsigned char *at_event, size_t n,
+                            double *jumps, size_t *njumps, double *drops, size_t *ndrops)
+{
+    odhs__create_begin();
+    if (!before || !after || !at_event || !njumps || !ndrops)
+        return odhs__create_err(ODHS_E_NULL, "odhs_series_event_split: NULL argument");
+    if (n == 0) return odhs__create_err(ODHS_E_EMPTY, "odhs_series_event_split: no samples");
+    int s = finite_all(before, n, "odhs_series_event_split (before)");
+    if (!s) s = finite_all(after, n, "odhs_series_event_split (after)");
+    if (s) return s;
+    size_t nj = 0, nd = 0, last = SIZE_MAX;
+    for (size_t k = 0; k < n; ++k) {
+        if (!at_event[k]) continue;
+        if (jumps) jumps[nj] = after[k] - before[k];
+        nj++;
+        if (last != SIZE_MAX) {
+            if (drops) drops[nd] = after[last] - before[k];
+            nd++;
+        }
+        last = k;
+    }
+    *njumps = nj;
+    *ndrops = nd;
+    return ODHS_OK;
+}
+
 int odhs_series_autocorrelation(const double *x, size_t n, size_t maxlag, double *rho)
 {
     odhs__create_begin();

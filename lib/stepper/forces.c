@@ -214,3 +214,42 @@ void odhs__st_contact_geometry(odhs_stepper *st, size_t c)
     for (int k = 0; k < dim; ++k) net->nrm[c * dim + k] = d[k] / r;
     net->version++;
 }
+
+/* ---- the stress before the step's events (odhs_stepper_pre_event_stress) --- */
+/* The contact forces on the current network (the step's start network) at
+ * the current configuration and time, solved as odhs__st_compute_forces
+ * does at fixed volume but into the record's own arrays: the step's state
+ * (forces, gradient, kappa) is untouched. A failed solve is recorded, not
+ * returned: only running out of memory fails the step. */
+int odhs__st_pre_event_record(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    if (st->drv->pressure_on) {
+        st->pre_pend_state = ODHS__PRE_PRESSURE;
+        return ODHS_OK;
+    }
+    if (st->pre_cap < net->nc) {
+        size_t c = st->pre_cap ? st->pre_cap : 64;
+        while (c < net->nc) c *= 2;
+        double *b = odhs__realloc(st->pre_b, c * sizeof *b);
+        if (b) st->pre_b = b;
+        double *x = odhs__realloc(st->pre_f, c * sizeof *x);
+        if (x) st->pre_f = x;
+        if (!b || !x) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+        st->pre_cap = c;
+    }
+    odhs__net_geometry(net, st->sys);
+    int s = ODHS_OK;
+    if (net->nc) {
+        double G[9];
+        memcpy(G, st->G, sizeof G);
+        odhs__st_set_gradient(st, st->drv->crate);
+        odhs__st_affine_rhs(st, st->pre_b);
+        memcpy(st->G, G, sizeof G);
+        s = odhs__solver_solve(st->sol, net, st->pre_b, st->pre_f, 1);
+    }
+    if (s == ODHS_E_NOMEM) return odhs__sterr(st, s, "force solve: %s", odhs_solver_errmsg(st->sol));
+    st->pre_pend_state = s ? ODHS__PRE_SOLVE : ODHS__PRE_OK;
+    if (!s) odhs__st_stress_of(st, st->pre_f, st->pre_pend);
+    return ODHS_OK;
+}

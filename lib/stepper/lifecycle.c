@@ -79,7 +79,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
     void *arrays[] = {st->disps, st->U0,  st->Ua,    st->Up, st->F,  st->U,     st->tmp,   st->cb,
                       st->cx,    st->pi,  st->pj,    st->disp, st->rem, st->fpj,  st->pj_res, st->chg,
                       st->xs,    st->sci, st->scj,   st->skind, st->sf, st->fr,   st->srest, st->ev,
-                      st->wsnap};
+                      st->wsnap, st->pre_b, st->pre_f};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
 }
@@ -191,6 +191,16 @@ int odhs_stepper_set_run_limits(odhs_stepper *st, uint64_t max_steps, uint64_t s
     return ODHS_OK;
 }
 
+int odhs_stepper_set_pre_event_stress(odhs_stepper *st, int on)
+{
+    if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
+    if (on != 0 && on != 1) return odhs__sterr(st, ODHS_E_INVALID, "on = %d must be 0 or 1", on);
+    if (on != st->pre_on) st->pre_state = ODHS__PRE_NONE;
+    st->pre_on = on;
+    return ODHS_OK;
+}
+
 int odhs_stepper_get_run_limits(const odhs_stepper *st, uint64_t *max_steps, uint64_t *stall_steps)
 {
     if (!st) return ODHS_E_NULL;
@@ -229,6 +239,7 @@ int odhs_stepper_reset(odhs_stepper *st)
     if (st->drv->fn_missing) return odhs__st_check_handles(st);
     st->ready = 0;
     st->jammed = 0;
+    st->pre_state = ODHS__PRE_NONE;
     odhs__solver_invalidate(st->sol); /* our network may reuse a freed address */
     if ((s = odhs__st_check_driver(st))) return s;
     if ((s = odhs_driver_time_unit(st->drv, st->sys, &st->tau))) return odhs__sterr(st, s, "%s", st->drv->errmsg);

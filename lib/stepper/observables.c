@@ -47,6 +47,12 @@ int odhs_stepper_stress(const odhs_stepper *st, double *sigma)
     NEED(st, sigma);
     int s = need_ready(st);
     if (s) return s;
+    odhs__st_stress_of(st, st->net->f, sigma);
+    return ODHS_OK;
+}
+
+void odhs__st_stress_of(const odhs_stepper *st, const double *f, double *sigma)
+{
     int dim = st->dim;
     const odhs_network *net = st->net;
     double vol;
@@ -55,12 +61,32 @@ int odhs_stepper_stress(const odhs_stepper *st, double *sigma)
     for (size_t c = 0; c < net->nc; ++c) {
         if (net->cj[c] >= st->n) continue; /* walls: see odhs_stepper_wall_force */
         const double *n = net->nrm + c * dim;
-        double w = net->f[c] * net->dist[c];
+        double w = f[c] * net->dist[c];
         for (int a = 0; a < dim; ++a)
             for (int b = 0; b < dim; ++b) sigma[a * dim + b] -= w * n[a] * n[b];
     }
     for (int a = 0; a < dim * dim; ++a) sigma[a] /= vol;
-    return ODHS_OK;
+}
+
+int odhs_stepper_pre_event_stress(const odhs_stepper *st, double *sigma)
+{
+    NEED(st, sigma);
+    switch (st->pre_state) {
+    case ODHS__PRE_OK:
+        memcpy(sigma, st->pre_sigma, (size_t)(st->dim * st->dim) * sizeof *sigma);
+        return ODHS_OK;
+    case ODHS__PRE_DRIVER:
+        return odhs__sterr(st, ODHS_E_STATE, "the last step only applied a change of the driver: no motion, no record");
+    case ODHS__PRE_PRESSURE:
+        return odhs__sterr(st, ODHS_E_STATE, "the pre-event stress is not recorded under pressure control");
+    case ODHS__PRE_SOLVE:
+        return odhs__sterr(st, ODHS_E_STATE,
+                           "the force solve on the network of the last step's start failed at its end configuration");
+    default:
+        return odhs__sterr(st, ODHS_E_STATE,
+                           st->pre_on ? "no step taken since the recording was switched on (or since a reset)"
+                                      : "the pre-event stress is not recorded: odhs_stepper_set_pre_event_stress(st, 1)");
+    }
 }
 
 int odhs_stepper_shear_stress(const odhs_stepper *st, double *sxy)

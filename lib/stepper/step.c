@@ -115,10 +115,15 @@ static int advance_to_event(odhs_stepper *st, const odhs__step_type *type, odhs_
         if (type->early && type->early(st, p)) continue;
         if ((s = move(st, p)) || (s = repeat(st, type->at_collision, p, &again))) return s;
         if (again) continue;
+        /* the external forces at the end time do not depend on the network:
+         * evaluated before the new contact, so that the pre-event record
+         * solves on the start network with them */
+        if ((s = odhs__st_external_forces(st))) return s;
+        if (st->pre_on && (s = odhs__st_pre_event_record(st))) return s;
         size_t c;
         if (p->ci != SIZE_MAX && (s = odhs__st_add_contact(st, p->ci, p->cj, &c))) return s;
         odhs__net_geometry(st->net, st->sys);
-        if ((s = odhs__st_external_forces(st)) || (s = repeat(st, type->at_opening, p, &again))) return s;
+        if ((s = repeat(st, type->at_opening, p, &again))) return s;
         if (!again) return ODHS_OK;
     }
 }
@@ -174,6 +179,7 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     if ((s = driver_update(st, &u, first, stop, &done))) return undo(st, &u, s);
     if (done) {
         st->last_driver_only = 1;
+        if (st->pre_on) st->pre_state = ODHS__PRE_DRIVER;
         return ODHS_OK;
     }
     /* the step starts from the forces and flow now, re-solved if the driver
@@ -188,7 +194,12 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     p.tsw = odhs__driver_next_switch(st->drv, st->time);
     p.dsw = p.tsw - st->time;
     p.limit = p.dsw <= limit ? p.dsw : limit;
+    st->pre_pend_state = ODHS__PRE_NONE;
     if ((s = advance_to_event(st, type, &p)) || (s = end_step(st, &p, &u, first, stop))) return undo(st, &u, s);
+    if (st->pre_on) {
+        st->pre_state = st->pre_pend_state;
+        memcpy(st->pre_sigma, st->pre_pend, sizeof st->pre_sigma);
+    }
     if (st->jammed)
         return odhs__sterr(st, ODHS_JAMMED, "jammed at t = %.17g: isostatic constrained subset, positive self-stress",
                            st->time);

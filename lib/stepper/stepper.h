@@ -118,10 +118,25 @@ struct odhs_stepper {
     uint64_t sys_version;  /* the system's change count the state belongs to */
     uint64_t max_steps;    /* steps one run call may take (0: no cap) */
     uint64_t stall_steps;  /* steps without progress before ODHS_E_STALLED (0: never) */
+    /* the stress before the step's events (since 0.2.8, observables.c):
+     * recorded when pre_on, at the end configuration of each step's motion
+     * on the network of its start; pending until the step succeeds */
+    int pre_on;
+    int pre_state, pre_pend_state; /* ODHS__PRE_*: why there is no value */
+    double pre_sigma[9], pre_pend[9];
+    double *pre_b, *pre_f;        /* contact-space work (pre_cap) */
+    size_t pre_cap;
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
 /* ==== shared by the stepper's files ======================================== */
+/* states of the pre-event stress record (odhs_stepper_pre_event_stress) */
+enum { ODHS__PRE_NONE = 0, ODHS__PRE_OK, ODHS__PRE_DRIVER, ODHS__PRE_PRESSURE, ODHS__PRE_SOLVE };
+/* the stress tensor (dim x dim) of contact forces f on the current network */
+void odhs__st_stress_of(const odhs_stepper *st, const double *f, double *sigma);
+/* record the stress at the current configuration on the current network
+ * (before the step's events) into the pending record (observables.c) */
+int odhs__st_pre_event_record(odhs_stepper *st);
 #define EPS_F 1e-12 /* relative threshold for negative forces   */
 #define EPS_V 1e-12 /* relative threshold for approaching pairs */
 

@@ -68,6 +68,28 @@ def autocorrelation(x, maxlag):
     return rho
 
 
+def event_split(before, after, at_event):
+    """Split an event-resolved signal (odhs_series_event_split): before[k]
+    and after[k] the values before and after step k's events, at_event[k]
+    true for the steps to split at. Returns (jumps, drops): after - before
+    at the marked steps, and after[k_m] - before[k_(m+1)] between
+    consecutive marked steps (how far the signal fell between them)."""
+    b, pb = _series(before, "before")
+    a, pa = _series(after, "after")
+    ev = np.ascontiguousarray(at_event, dtype=bool).ravel().astype(np.uint8)
+    if not (b.size == a.size == ev.size):
+        raise make_error(lib.ODHS_E_DIM, "before, after and at_event differ in length", "event_split")
+    pe = ffi.from_buffer("unsigned char[]", ev)
+    n = b.size
+    jumps, pj = out_array((max(n, 1),))
+    drops, pd = out_array((max(n, 1),))
+    nj, nd = ffi.new("size_t *"), ffi.new("size_t *")
+    rc = lib.odhs_series_event_split(pb, pa, pe, n, pj, nj, pd, nd)
+    if rc:
+        _raise(rc, "event_split")
+    return jumps[: int(nj[0])].copy(), drops[: int(nd[0])].copy()
+
+
 def histogram(x, lo, hi, nbins, log_bins=False):
     """The histogram of x on [lo, hi] in nbins bins, equal in x or in log x
     (odhs_histogram). Returns a Histogram."""

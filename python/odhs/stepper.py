@@ -407,6 +407,23 @@ class Stepper(Owned):
         return Errors(g[0], o[0])
 
     # --- array observables ---------------------------------------------------------------
+    def set_pre_event_stress(self, on=True):
+        """Record the stress just before each step's events (one more force
+        solve per step; odhs_stepper_set_pre_event_stress)."""
+        rc = lib.odhs_stepper_set_pre_event_stress(self._p or self._closed(), 1 if on else 0)
+        if rc:
+            self._err(rc, "Stepper.set_pre_event_stress")
+
+    def pre_event_stress(self):
+        """The stress tensor (dim, dim) at the end of the last step's motion
+        on the network of its start (odhs_stepper_pre_event_stress;
+        StateError, with the reason, when there is no record)."""
+        arr, p = out_array((self._dim, self._dim))
+        rc = lib.odhs_stepper_pre_event_stress(self._p or self._closed(), p)
+        if rc:
+            self._err(rc, "Stepper.pre_event_stress")
+        return arr
+
     @property
     def stress(self):
         """Stress tensor (dim, dim) (copy; odhs_stepper_stress)."""

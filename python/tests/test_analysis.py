@@ -84,3 +84,35 @@ def test_collapse_fit():
     with pytest.raises(odhs.EmptyError) as e:
         analysis.collapse_fit(phi[:11], rate[:11], val[:11])
     assert "same rate" in e.value.message
+
+
+def test_event_split_and_pre_event_stress():
+    # the synthetic sawtooth of the C test
+    before = np.array([9.9, 9.8, 9.7, 10.6, 12.5, 12.4, 12.8, 12.7, 15.6])
+    after = np.array([9.9, 9.8, 10.7, 12.6, 12.5, 12.9, 12.8, 15.7, 15.6])
+    ev = [0, 0, 1, 1, 0, 0, 0, 1, 0]
+    jumps, drops = analysis.event_split(before, after, ev)
+    assert np.allclose(jumps, [1, 2, 3]) and np.allclose(drops, [0.1, 0.4 - 0.5])
+    with pytest.raises(odhs.Error):
+        analysis.event_split(before, after[:3], ev)
+    # a sheared packing: a collision without openings never lowers sigma_xy
+    s = odhs.System(2, 64)
+    s.set_radii_bidisperse(0.5, 1.4, 0.0, 3)
+    s.place_random(0.45, 3)
+    d = odhs.Driver(compression_rate=1.0)
+    st = odhs.Stepper(s, d, odhs.Solver("cholmod"))
+    st.run_until_packing_fraction(0.80)
+    d.compression_rate = 0.0
+    d.shear_rate = 1.0
+    with pytest.raises(odhs.StateError):
+        st.pre_event_stress()
+    st.set_pre_event_stress(True)
+    rows = []
+    for _ in range(200):
+        _, info = st.step_ex()
+        if not info.advanced:  # a driver change applied, no motion: no record
+            continue
+        rows.append((st.pre_event_stress()[0, 1], st.stress[0, 1], info.collisions, info.openings))
+    b, a, c, o = (np.array(x) for x in zip(*rows))
+    jumps, _ = analysis.event_split(b, a, (c > 0) & (o == 0))
+    assert jumps.size > 5 and jumps.min() > -1e-9 * a.max()
