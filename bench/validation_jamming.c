@@ -11,7 +11,9 @@
  *   the relative gap h for gamma (default 1e-2).
  * Output: one row per packing, then the means with standard errors over
  * seeds, and the exponents from the pooled samples (Hill's estimator, error
- * (a+1)/sqrt(m)) and as mean +- standard error of the per-packing values.
+ * (a+1)/sqrt(m)) and as mean +- standard error of the per-packing values;
+ * theta also separately for extended and localized contacts (a contact is
+ * localized when one of its particles has exactly d + 1 backbone contacts).
  *
  * Scene: radii 0.5 (and 0.7) with 3% uniform polydispersity (as
  * bench/jamming; exactly equal radii make degenerate networks that slow the
@@ -63,8 +65,8 @@ int main(int argc, char **argv)
     double *phis = malloc(nseeds * sizeof *phis), *zs = malloc(nseeds * sizeof *zs),
            *rats = malloc(nseeds * sizeof *rats), *ths = malloc(nseeds * sizeof *ths),
            *gas = malloc(nseeds * sizeof *gas);
-    size_t fcap = 0, fn = 0, hcap = 0, hn = 0;
-    double *fall = NULL, *hall = NULL;
+    size_t fcap = 0, fn = 0, hcap = 0, hn = 0, ecap = 0, en = 0, lcap = 0, ln = 0;
+    double *fall = NULL, *hall = NULL, *fext = NULL, *floc = NULL;
     int good = 0;
     for (int seed = 1; seed <= nseeds; ++seed) {
         double t0 = bench_cpu();
@@ -96,6 +98,32 @@ int main(int argc, char **argv)
         double fm = 0.0;
         for (size_t k = 0; k < nb; ++k) fm += fall[fn + k] / (double)nb;
         for (size_t k = 0; k < nb; ++k) fall[fn + k] /= fm;
+        {
+            /* extended and localized contacts (Lerner, During and Wyart
+             * 2013; Charbonneau et al. 2015): a backbone contact is
+             * localized when one of its particles has exactly d + 1
+             * backbone contacts (a buckler) */
+            size_t nc = odhs_network_count(net), nrat = 0;
+            size_t *ci = malloc((nc + 1) * sizeof *ci), *cj = malloc((nc + 1) * sizeof *cj);
+            int *kind = malloc((nc + 1) * sizeof *kind);
+            double *f = malloc((nc + 1) * sizeof *f);
+            unsigned char *rat = malloc(n);
+            unsigned *deg = calloc(n, sizeof *deg);
+            odhs_network_get_contacts(net, ci, cj, kind);
+            odhs_network_get_forces(net, f);
+            odhs_network_rattlers(net, rat, &nrat);
+            for (size_t k = 0; k < nc; ++k)
+                if (kind[k] == ODHS_CONTACT_TEMPORARY && !rat[ci[k]] && !rat[cj[k]]) deg[ci[k]]++, deg[cj[k]]++;
+            if (en + nc > ecap) fext = realloc(fext, (ecap = 2 * (en + nc)) * sizeof *fext);
+            if (ln + nc > lcap) floc = realloc(floc, (lcap = 2 * (ln + nc)) * sizeof *floc);
+            for (size_t k = 0; k < nc; ++k) {
+                if (kind[k] != ODHS_CONTACT_TEMPORARY || rat[ci[k]] || rat[cj[k]]) continue;
+                int loc = deg[ci[k]] == (unsigned)dim + 1 || deg[cj[k]] == (unsigned)dim + 1;
+                if (loc) floc[ln++] = f[k] / fm;
+                else fext[en++] = f[k] / fm;
+            }
+            free(ci), free(cj), free(kind), free(f), free(rat), free(deg);
+        }
         odhs_packing_gaps(sys, net, 0.1, 0, &ng, NULL, NULL, NULL, NULL);
         double *h = malloc((ng + 1) * sizeof *h);
         int *role = malloc((ng + 1) * sizeof *role);
@@ -142,6 +170,17 @@ int main(int argc, char **argv)
            fmax, mth, e4);
     printf("gamma      pooled %.3f +- %.3f (%zu backbone gaps <= %g); per packing %.3f +- %.3f\n", -pga, pgae, mga_n,
            hmax, mga, e5);
+    {
+        double te, tee, tl, tle;
+        size_t ue = 0, ul = 0;
+        if (odhs_power_law_exponent(fext, en, fmax, &te, &tee, &ue)) te = tee = NAN;
+        if (odhs_power_law_exponent(floc, ln, fmax, &tl, &tle, &ul)) tl = tle = NAN;
+        printf("theta_e    pooled %.3f +- %.3f (%zu of %zu extended contacts <= %g <f>)\n", te, tee, ue, en, fmax);
+        printf("theta_l    pooled %.3f +- %.3f (%zu of %zu localized contacts <= %g <f>: a particle with d + 1 "
+               "backbone contacts)\n",
+               tl, tle, ul, ln, fmax);
+    }
+    free(fext), free(floc);
     free(fall), free(hall), free(phis), free(zs), free(rats), free(ths), free(gas);
     return 0;
 }
