@@ -26,6 +26,7 @@
 
 #include "odhs.h"
 #include "bench.h"
+#include "scene.h"
 
 #define NSAMP 200
 
@@ -77,18 +78,7 @@ int main(int argc, char **argv)
            n, seed, transient, measure, cpu, getenv("OPENBLAS_NUM_THREADS") ? getenv("OPENBLAS_NUM_THREADS") : "unset");
     const double phi0 = 0.78;
     odhs_system *base;
-    odhs_driver *drv;
-    odhs_solver *sol;
-    odhs_stepper *st;
-    if (odhs_system_create(2, n, &base) || odhs_system_set_radii_bidisperse(base, 0.5, 1.4, 0.0, seed) ||
-        odhs_system_place_random(base, 0.45, seed) || odhs_driver_create(&drv) ||
-        odhs_driver_set_compression_rate(drv, 1.0) || odhs_solver_create_by_name("auto", &sol) ||
-        odhs_stepper_create(base, drv, sol, &st))
-        return fail("setup", odhs_last_error());
-    if (odhs_stepper_run_until_packing_fraction(st, phi0) != ODHS_OK) return fail("compression", odhs_stepper_errmsg(st));
-    odhs_stepper_destroy(st);
-    odhs_solver_destroy(sol);
-    odhs_driver_destroy(drv);
+    if (bench_disc_scene(n, 0.0, seed, phi0, &base)) return 1;
 
     char path[1024];
     snprintf(path, sizeof path, "%s.csv", prefix);
