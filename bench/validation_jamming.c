@@ -31,6 +31,7 @@
 
 #include "odhs.h"
 #include "bench.h"
+#include "../examples/plot.h"
 
 static double mean_sem(const double *x, int n, double *sem)
 {
@@ -179,6 +180,59 @@ int main(int argc, char **argv)
         printf("theta_l    pooled %.3f +- %.3f (%zu of %zu localized contacts <= %g <f>: a particle with d + 1 "
                "backbone contacts)\n",
                tl, tle, ul, ln, fmax);
+    }
+    /* the exponents against their cut-offs: a plateau shows the power-law
+     * range; and the distributions, written to validation_jamming_<d>d_N<n>.svg */
+    printf("cut-off scan (pooled): f/<f> <=");
+    const double fc[6] = {0.02, 0.05, 0.1, 0.2, 0.3, 0.5}, hc[6] = {1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2};
+    for (int k = 0; k < 6; ++k) {
+        double a, e;
+        size_t u = 0;
+        if (odhs_power_law_exponent(fall, fn, fc[k], &a, &e, &u)) a = e = NAN;
+        printf("  %g: theta %.3f +- %.3f (%zu)", fc[k], a, e, u);
+    }
+    printf("\ncut-off scan (pooled): h <=");
+    for (int k = 0; k < 6; ++k) {
+        double a, e;
+        size_t u = 0;
+        if (odhs_power_law_exponent(hall, hn, hc[k], &a, &e, &u)) a = e = NAN;
+        printf("  %g: gamma %.3f +- %.3f (%zu)", hc[k], -a, e, u);
+    }
+    printf("\n");
+    {
+        pl_plot pf, ph;
+        char title[160], path[128], note[200];
+        snprintf(title, sizeof title, "Backbone contact forces, %dD, N = %zu, %d packings", dim, n, good);
+        pl_init(&pf, title, "f / <f>", "P(f / <f>)", 1, 1);
+        snprintf(title, sizeof title, "Gaps of backbone pairs, %dD, N = %zu", dim, n);
+        pl_init(&ph, title, "h = r / (a_i + a_j) - 1", "g(h)", 1, 1);
+        double edges[31], dens[30];
+        struct {
+            pl_plot *p;
+            const char *name;
+            const double *x;
+            size_t m;
+            double lo, hi;
+        } sets[4] = {{&pf, "all backbone contacts", fall, fn, 1e-4, 10.0},
+                     {&pf, "extended", fext, en, 1e-4, 10.0},
+                     {&pf, "localized (buckler)", floc, ln, 1e-4, 10.0},
+                     {&ph, "backbone pairs", hall, hn, 1e-8, 0.1}};
+        for (int k = 0; k < 4; ++k) {
+            if (!sets[k].m || odhs_histogram(sets[k].x, sets[k].m, sets[k].lo, sets[k].hi, 30, 1, edges, dens, NULL, NULL))
+                continue;
+            int sr = pl_series_add(sets[k].p, sets[k].name, k, 0, 1);
+            for (int b = 0; b < 30; ++b)
+                if (dens[b] > 0) pl_point(sets[k].p, sr, sqrt(edges[b] * edges[b + 1]), dens[b]);
+        }
+        snprintf(note, sizeof note, "bench/validation_jamming %d %zu %d; theta %.2f, gamma %.2f (pooled Hill fits)",
+                 dimarg, n, nseeds, pth, -pga);
+        pl_note(&pf, note);
+        pl_note(&ph, note);
+        const pl_plot *panels[2] = {&pf, &ph};
+        snprintf(path, sizeof path, "validation_jamming_%dd_N%zu.svg", dim, n);
+        pl_write_svg_panels(panels, 2, path);
+        pl_free(&pf);
+        pl_free(&ph);
     }
     free(fext), free(floc);
     free(fall), free(hall), free(phis), free(zs), free(rats), free(ths), free(gas);
