@@ -263,7 +263,8 @@ ODHS_API int odhs_stepper_stress(const odhs_stepper *st, double *sigma);
  * without it; solvers that keep state between solves (cg warm starts,
  * cholmod-pcg, auto's choices) may differ within their tolerance. Not
  * recorded under pressure control. Switching changes nothing else and
- * clears the record. Since 0.2.8.
+ * clears the record; checkpoints do not store it (a stepper read from one
+ * starts with the record off). Since 0.2.8.
  */
 ODHS_API int odhs_stepper_set_pre_event_stress(odhs_stepper *st, int on);
 /**
