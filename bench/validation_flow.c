@@ -3,12 +3,14 @@
  * volume, its jumps at collisions and its relaxation between them, the
  * stress autocorrelation, and a picture of the force network.
  *
- * usage: validation_flow N PHI TRANSIENT WINDOW SEED PREFIX [SEGMENT]
+ * usage: validation_flow N PHI TRANSIENT WINDOW SEED PREFIX [SEGMENT [SOLVER [INTEGRATOR]]]
  *   N bidisperse discs (radii 0.5 and 0.7, 50:50, 3% polydispersity) at
  *   packing fraction PHI, sheared at rate 1 for TRANSIENT strain (not
  *   measured), then for WINDOW strain with the pre-event stress recorded
  *   (odhs_stepper_set_pre_event_stress) at every step. SEGMENT (default
- *   0.002) is the strain drawn in the signal plot.
+ *   0.002) is the strain drawn in the signal plot. SOLVER (default auto)
+ *   and INTEGRATOR (heun, the default, or euler: the paper's fixed step
+ *   1e-3 without drift correction) change the library's defaults.
  * Writes PREFIX_signal.svg (sigma_xy against strain over the segment: the
  * relaxation while a network lasts and the jump at each step's events),
  * PREFIX_dist.svg (distributions of the jumps at collisions and of the
@@ -83,6 +85,12 @@ int main(int argc, char **argv)
     unsigned seed = (unsigned)atoi(argv[5]);
     const char *prefix = argv[6];
     double segment = argc > 7 ? atof(argv[7]) : 0.002;
+    const char *solver = argc > 8 ? argv[8] : "auto", *integ = argc > 9 ? argv[9] : "heun";
+    int euler = !strcmp(integ, "euler");
+    if (!euler && strcmp(integ, "heun")) {
+        fprintf(stderr, "validation_flow: integrator heun or euler\n");
+        return 2;
+    }
     if (n < 16 || !(phi > 0.5 && phi < 0.9) || !(transient >= 0) || !(window > 0) || !(segment > 0)) {
         fprintf(stderr, "validation_flow: bad arguments\n");
         return 2;
@@ -90,8 +98,8 @@ int main(int argc, char **argv)
     char cpu[128], path[1024];
     bench_cpu_model(cpu, sizeof cpu);
     printf("# validation_flow: 2D bidisperse 1:1.4, N = %zu, phi = %.4f, seed %u, transient %g, window %g\n"
-           "# library defaults (adaptive Heun, auto solver); machine: %s, OPENBLAS_NUM_THREADS=%s\n",
-           n, phi, seed, transient, window, cpu,
+           "# solver %s, integrator %s; machine: %s, OPENBLAS_NUM_THREADS=%s\n",
+           n, phi, seed, transient, window, solver, euler ? "euler dt 1e-3, no drift correction" : "adaptive heun", cpu,
            getenv("OPENBLAS_NUM_THREADS") ? getenv("OPENBLAS_NUM_THREADS") : "unset");
     double c0 = bench_cpu();
     odhs_system *sys;
@@ -101,12 +109,17 @@ int main(int argc, char **argv)
     CHECK(odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed));
     CHECK(odhs_system_place_random(sys, 0.45, seed));
     CHECK(odhs_driver_create(&drv));
-    CHECK(odhs_solver_create_by_name("auto", &sol));
+    CHECK(odhs_solver_create_by_name(solver, &sol));
     CHECK(odhs_driver_set_compression_rate(drv, 1.0));
     CHECK(odhs_stepper_create(sys, drv, sol, &st));
     CHECK(odhs_stepper_run_until_packing_fraction(st, phi));
     CHECK(odhs_driver_set_compression_rate(drv, 0.0));
     CHECK(odhs_driver_set_shear_rate(drv, 1.0));
+    if (euler) {
+        CHECK(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER));
+        CHECK(odhs_stepper_set_dt(st, 1e-3));
+        CHECK(odhs_stepper_set_correction_interval(st, 0));
+    }
     double c1 = bench_cpu();
     CHECK(odhs_stepper_run_until_strain(st, transient));
     double c2 = bench_cpu(), g_start;
@@ -258,8 +271,8 @@ int main(int argc, char **argv)
     }
     p.s[s_col].lines = 0;
     char note[200];
-    snprintf(note, sizeof note, "bench/validation_flow %zu %g %g %g %u; defaults (Heun, auto); %.60s", n, phi,
-             transient, window, seed, cpu);
+    snprintf(note, sizeof note, "bench/validation_flow %zu %g %g %g %u; %s, %s; %.60s", n, phi, transient, window, seed,
+             solver, integ, cpu);
     pl_note(&p, note);
     snprintf(path, sizeof path, "%s_signal.svg", prefix);
     pl_write_svg(&p, path);
