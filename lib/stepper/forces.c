@@ -241,10 +241,15 @@ int odhs__st_pre_event_record(odhs_stepper *st)
     odhs__net_geometry(net, st->sys);
     int s = ODHS_OK;
     if (net->nc) {
+        /* the flow at the end of the motion: its left limit in time (a
+         * triangle wave reverses at the step's end) */
         double G[9];
+        const int fe = st->flow_end;
         memcpy(G, st->G, sizeof G);
+        st->flow_end = 1;
         odhs__st_set_gradient(st, st->drv->crate);
         odhs__st_affine_rhs(st, st->pre_b);
+        st->flow_end = fe;
         memcpy(st->G, G, sizeof G);
         s = odhs__solver_solve(st->sol, net, st->pre_b, st->pre_f, 1);
     }
