@@ -667,6 +667,37 @@ START_TEST(test_pre_event_stress)
     ck_assert_int_eq(odhs_stepper_stress(b.st, sb), ODHS_OK);
     ck_assert_msg(memcmp(xa, xb, sizeof xa) == 0 && memcmp(sig, sb, sizeof sb) == 0,
                   "a run with the record differs from one without");
+    /* at a reversal of a triangle wave the record is the stress under the
+     * old direction (the flow's left limit): positive like the stress just
+     * before, while the reversed flow opens the network */
+    {
+        odhs_system *s3 = scene(64, 0.80, 0, 4);
+        rig c = rig_new(s3);
+        double t0;
+        ck_assert_int_eq(odhs_stepper_set_integrator(c.st, ODHS_INTEGRATOR_EULER), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_dt(c.st, 1e-3), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_correction_interval(c.st, 0), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_time(c.st, &t0), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_set_oscillatory_shear(c.drv, ODHS_OSCILLATION_TRIANGLE, 0.05, 0.2, t0), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_pre_event_stress(c.st, 1), ODHS_OK);
+        double last = 0.0;
+        int seen = 0;
+        for (int k = 0; k < 20000 && !seen; ++k) {
+            odhs_step_info in = {.size = sizeof in};
+            ck_assert_int_eq(odhs_stepper_step_ex(c.st, &in), ODHS_OK);
+            if (!in.advanced) continue;
+            ck_assert_int_eq(odhs_stepper_pre_event_stress(c.st, pre), ODHS_OK);
+            if (in.time_end == t0 + 0.05) { /* the first reversal, t0 + T/4 */
+                seen = 1;
+                ck_assert_msg(last > 0.0 && pre[1] > 0.5 * last, "pre-event %g at the reversal, %g before", pre[1],
+                              last);
+            }
+            ck_assert_int_eq(odhs_stepper_stress(c.st, sig), ODHS_OK);
+            last = sig[1];
+        }
+        ck_assert_msg(seen, "no step ended at the reversal");
+        rig_free(&c);
+    }
     /* a driver change with no motion has no record; pressure control none */
     ck_assert_int_eq(odhs_driver_set_shear_rate(a.drv, 2.0), ODHS_OK);
     ck_assert_int_eq(odhs_stepper_step(a.st, NULL), ODHS_OK);
