@@ -4,7 +4,7 @@
  *     eta = A (phi_c - phi)^(-beta)
  * over the points with phi >= PHI_MIN, for each N.
  *
- * usage: validation_viscosity TRANSIENT PHI_MIN PREFIX DIR...
+ * usage: validation_viscosity TRANSIENT PHI_MIN PREFIX [-f PHI_C] DIR...
  *   DIR: output directories of examples/sweep_serial or sweep_mpi (shear at
  *   fixed volume, gammadot = 1, xi0 = 1); the runs are read from
  *   DIR/campaign.txt and DIR/runs/run_NNNN/series.csv. Each run's
@@ -15,7 +15,8 @@
  * The fit: for each trial phi_c (grid of 1e-5 above the largest phi) a
  * weighted straight line of ln eta against ln(phi_c - phi); the phi_c of
  * least chi^2, and errors of phi_c and beta from chi^2 = min + 1 (scaled by
- * chi^2/dof when that exceeds 1). Prints the table and the fit per N and
+ * chi^2/dof when that exceeds 1); with -f also beta at the given phi_c
+ * (e.g. a published phi_J). Prints the table and the fit per N and
  * writes PREFIX.svg (eta against phi_c - phi, log-log, with the fits).
  */
 #define _POSIX_C_SOURCE 200809L
@@ -171,7 +172,13 @@ int main(int argc, char **argv)
     }
     double transient = atof(argv[1]), phimin = atof(argv[2]);
     const char *prefix = argv[3];
-    for (int a = 4; a < argc; ++a)
+    int first = 4;
+    double phic_fixed = NAN;
+    if (argc > 6 && !strcmp(argv[4], "-f")) {
+        phic_fixed = atof(argv[5]);
+        first = 6;
+    }
+    for (int a = first; a < argc; ++a)
         if (read_dir(argv[a], transient)) fprintf(stderr, "validation_viscosity: %s: no campaign.txt\n", argv[a]);
     if (npts == 0) return 1;
     qsort(pts, (size_t)npts, sizeof *pts, cmp_point);
@@ -228,6 +235,20 @@ int main(int argc, char **argv)
             printf("N = %zu: phi_c = %.4f (+%.4f -%.4f), beta = %.2f (+%.2f -%.2f), chi2/dof = %.2f (%d points)%s\n",
                    pts[k0].n, bphi, pmax - bphi, bphi - pmin, bb, bmax - bb, bb - bmin, dof > 0 ? best / dof : NAN,
                    m, pmin <= lo + 1e-9 ? " (phi_c at the edge: the largest phi bounds it)" : "");
+            if (phic_fixed > ph[m - 1]) {
+                /* beta at a given phi_c */
+                double a0, b0, c0 = line_fit(ph, et, rel, m, phic_fixed, &a0, &b0);
+                /* the slope's error of a weighted line: sqrt(S / det) */
+                double S = 0, Sx = 0, Sxx = 0;
+                for (int k = 0; k < m; ++k) {
+                    double w = 1.0 / (rel[k] * rel[k]), x = log(phic_fixed - ph[k]);
+                    S += w, Sx += w * x, Sxx += w * x * x;
+                }
+                int dof1 = m - 2;
+                double sc = dof1 > 0 && c0 / dof1 > 1 ? c0 / dof1 : 1.0;
+                printf("N = %zu, phi_c fixed at %.4f: beta = %.2f +- %.2f, chi2/dof = %.2f\n", pts[k0].n, phic_fixed,
+                       b0, sqrt(sc * S / (S * Sxx - Sx * Sx)), dof1 > 0 ? c0 / dof1 : NAN);
+            }
             char name[96];
             snprintf(name, sizeof name, "N = %zu (phi >= %g)", pts[k0].n, phimin);
             int s = pl_series_add(&pl, name, color, 0, 1);
