@@ -3,7 +3,9 @@
  *     O(phi, rate) = rate^(y / z nu) F((phi - phi_J) / rate^(1 / z nu)),
  * eq. (5.2) of Vagberg's thesis, from a CSV file with columns phi, rate, the
  * observable (default column "shear_stress"; --value NAME) and, if present,
- * its relative error (column "<NAME>_err", else --rel-err). Prints phi_J, y,
+ * its relative error (column "<NAME>_err", else --rel-err; with --err-absolute
+ * the column holds absolute errors, as sweep summaries and the benchmarks'
+ * tables do). Prints phi_J, y,
  * z nu with their errors and chi2 per degree of freedom; --plot draws the
  * collapsed data (each rate its colour) on the fitted master curve.
  *
@@ -38,7 +40,7 @@ typedef struct {
 } data;
 
 /* read the CSV: 0, or 1 with a message */
-static int read_csv(const char *path, const char *value, double rel_err, data *d)
+static int read_csv(const char *path, const char *value, double rel_err, int err_abs, data *d)
 {
     FILE *f = fopen(path, "r");
     if (!f) {
@@ -97,7 +99,7 @@ static int read_csv(const char *path, const char *value, double rel_err, data *d
         d->phi[d->n] = v[cp];
         d->rate[d->n] = v[cr];
         d->val[d->n] = v[cv];
-        d->err[d->n] = ce >= 0 ? v[ce] : rel_err;
+        d->err[d->n] = ce < 0 ? rel_err : err_abs ? fabs(v[ce] / v[cv]) : v[ce];
         d->n++;
     }
     fclose(f);
@@ -108,13 +110,14 @@ int main(int argc, char **argv)
 {
     const char *path = NULL, *value = "shear_stress", *guess_s = NULL, *plot = NULL;
     double rel_err = 0.01;
-    int degree = 3, quiet = 0;
+    int degree = 3, quiet = 0, err_abs = 0;
     const cli_opt opts[] = {
         CLI_OPT_STRING("--data", &path, "FILE.csv", "the flow curves: a header line naming phi, rate, the value",
                        CLI_ANY),
         CLI_OPT_STRING("--value", &value, "NAME", "the observable's column (its error: NAME_err)", CLI_ANY),
         CLI_OPT_DOUBLE("--rel-err", &rel_err, "E", "relative error of each value without a NAME_err column",
                        CLI_POSITIVE),
+        CLI_OPT_FLAG("--err-absolute", &err_abs, "the NAME_err column holds absolute errors (default: relative)"),
         CLI_OPT_INT("--degree", &degree, "K", "degree of the master curve's polynomial in ln F", CLI_BETWEEN(1, 7)),
         CLI_OPT_STRING("--guess", &guess_s, "PHIJ,Y,ZNU", "starting point (default: the largest phi, 1, 3)", CLI_ANY),
         CLI_OPT_STRING("--plot", &plot, "FILE.svg", "draw the collapse: ln(O / rate^q) against x", CLI_ANY),
@@ -138,7 +141,7 @@ int main(int argc, char **argv)
         return 2;
     }
     data d = {0};
-    if (read_csv(path, value, rel_err, &d)) return 1;
+    if (read_csv(path, value, rel_err, err_abs, &d)) return 1;
     odhs_collapse c;
     memset(&c, 0, sizeof c);
     c.size = sizeof c;

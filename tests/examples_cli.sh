@@ -311,5 +311,18 @@ awk '/^phi_J/ { ok1 = ($3 - 0.8433)^2 <= 9 * $5^2 } /^y / { ok2 = ($3 - 1.1)^2 <
     && pass=$((pass + 1)) || { echo "FAIL: collapse recovers phi_J, y, z nu"; sed 's/^/  | /' "$tmp/out"; fail=$((fail + 1)); }
 [ "$(grep -c '<circle\|<rect\|<path\|<polygon' "$tmp/col.svg")" -gt 44 ] && pass=$((pass + 1)) \
     || { echo "FAIL: collapse plot"; fail=$((fail + 1)); }
+# errors: a relative column (2 %) and the same as absolute errors with
+# --err-absolute give the same fit; read as relative, the absolute column
+# (values ~1e-2, errors ~1e-4) weighs the points differently
+awk -F, 'NR == 1 { print $0 ",shear_stress_err"; next } { print $0 ",0.02" }' "$tmp/flow.csv" > "$tmp/flow_rel.csv"
+awk -F, 'NR == 1 { print $0 ",shear_stress_err"; next } { printf "%s,%.10g\n", $0, 0.02 * $3 }' "$tmp/flow.csv" > "$tmp/flow_abs.csv"
+expect 0 "collapse relative errors" -- "$bin/collapse" --data "$tmp/flow_rel.csv" --guess 0.84,1,3
+cp "$tmp/out" "$tmp/out_rel"
+expect 0 "collapse --err-absolute" -- "$bin/collapse" --data "$tmp/flow_abs.csv" --guess 0.84,1,3 --err-absolute
+cmp -s <(grep -v "^collapse:" "$tmp/out_rel") <(grep -v "^collapse:" "$tmp/out") && pass=$((pass + 1)) \
+    || { echo "FAIL: collapse --err-absolute differs from the relative column"; diff "$tmp/out_rel" "$tmp/out"; fail=$((fail + 1)); }
+expect 0 "collapse absolute column read as relative" -- "$bin/collapse" --data "$tmp/flow_abs.csv" --guess 0.84,1,3
+cmp -s <(grep -v "^collapse:" "$tmp/out_rel") <(grep -v "^collapse:" "$tmp/out") && { echo "FAIL: collapse ignores the error column"; fail=$((fail + 1)); } \
+    || pass=$((pass + 1))
 echo "examples-cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
