@@ -228,16 +228,9 @@ int odhs__st_pre_event_record(odhs_stepper *st)
         st->pre_pend_state = ODHS__PRE_PRESSURE;
         return ODHS_OK;
     }
-    if (st->pre_cap < net->nc) {
-        size_t c = st->pre_cap ? st->pre_cap : 64;
-        while (c < net->nc) c *= 2;
-        double *b = odhs__realloc(st->pre_b, c * sizeof *b);
-        if (b) st->pre_b = b;
-        double *x = odhs__realloc(st->pre_f, c * sizeof *x);
-        if (x) st->pre_f = x;
-        if (!b || !x) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
-        st->pre_cap = c;
-    }
+    if (odhs__reserve((void **)&st->pre_b, &st->pre_bcap, net->nc, sizeof *st->pre_b) ||
+        odhs__reserve((void **)&st->pre_f, &st->pre_fcap, net->nc, sizeof *st->pre_f))
+        return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     odhs__net_geometry(net, st->sys);
     int s = ODHS_OK;
     if (net->nc) {

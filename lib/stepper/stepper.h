@@ -124,8 +124,8 @@ struct odhs_stepper {
     int pre_on;
     int pre_state, pre_pend_state; /* ODHS__PRE_*: why there is no value */
     double pre_sigma[9], pre_pend[9];
-    double *pre_b, *pre_f;        /* contact-space work (pre_cap) */
-    size_t pre_cap;
+    double *pre_b, *pre_f;        /* contact-space work */
+    size_t pre_bcap, pre_fcap;
     char errmsg[ODHS_ERRMSG_LEN];
 };
 
@@ -135,7 +135,7 @@ enum { ODHS__PRE_NONE = 0, ODHS__PRE_OK, ODHS__PRE_DRIVER, ODHS__PRE_PRESSURE, O
 /* the stress tensor (dim x dim) of contact forces f on the current network */
 void odhs__st_stress_of(const odhs_stepper *st, const double *f, double *sigma);
 /* record the stress at the current configuration on the current network
- * (before the step's events) into the pending record (observables.c) */
+ * (before the step's events) into the pending record (forces.c) */
 int odhs__st_pre_event_record(odhs_stepper *st);
 #define EPS_F 1e-12 /* relative threshold for negative forces   */
 #define EPS_V 1e-12 /* relative threshold for approaching pairs */
