@@ -52,6 +52,8 @@
 #
 # Knobs (set on the command line, e.g. `make SUITESPARSE=0 check`):
 #   SUITESPARSE=auto|1|0   CHOLMOD/SPQR backends (auto: if cholmod.h exists)
+#   CLP=auto|1|0           COIN-OR CLP for odhs_stepper_jam_lp (auto: if
+#                          coin/Clp_C_Interface.h exists)
 #   OPTFLAGS=-O2 -g        optimisation/debug flags
 #   WARNFLAGS=...          warnings (default includes -Werror)
 #   CC, CFLAGS, CPPFLAGS, LDFLAGS, LDLIBS   appended as usual
@@ -135,12 +137,36 @@ else
   SUITESPARSE_LIBS     :=
 endif
 
+# ---------------------------------------------------------------------------
+# Optional COIN-OR CLP (the LP solver of odhs_stepper_jam_lp, the fast route
+# to jammed packings; Debian coinor-libclp-dev). Its C interface is linked
+# from C; CLP itself is C++, so a static link needs -lstdc++ too.
+# ---------------------------------------------------------------------------
+CLP     ?= auto
+CLP_INC ?= /usr/include/coin
+ifeq ($(CLP),auto)
+  HAVE_CLP := $(if $(wildcard $(CLP_INC)/Clp_C_Interface.h),1,0)
+else ifneq ($(filter 1 yes on true,$(CLP)),)
+  HAVE_CLP := 1
+else ifneq ($(filter 0 no off false,$(CLP)),)
+  HAVE_CLP := 0
+else
+  $(error CLP must be auto, 1 or 0 (got '$(CLP)'))
+endif
+ifeq ($(HAVE_CLP),1)
+  CLP_CPPFLAGS := -DODHS_HAVE_CLP=1
+  CLP_LIBS     := -lClp -lCoinUtils
+else
+  CLP_CPPFLAGS :=
+  CLP_LIBS     :=
+endif
+
 # LAPACKE/LAPACK/BLAS are always required.
 MATH_LIBS := -llapacke -llapack -lblas -lm
 
 # Everything the library itself links against, the system libraries being
 # shared (`make print-libs` prints it for linking lib/libodhs.a).
-ODHS_LIBS    := $(SUITESPARSE_LIBS) $(MATH_LIBS)
+ODHS_LIBS    := $(CLP_LIBS) $(SUITESPARSE_LIBS) $(MATH_LIBS)
 
 # ---------------------------------------------------------------------------
 # odhs.pc's static-link fields, what `pkg-config --static --libs odhs` adds
@@ -166,7 +192,8 @@ ODHS_LIBS    := $(SUITESPARSE_LIBS) $(MATH_LIBS)
 PC_MATH_MODULES := lapacke lapack blas
 PC_SUITESPARSE_STATIC := -lspqr -lcholmod -lccolamd -lcamd -lcolamd -lamd -lmetis \
                          -lsuitesparseconfig -lgomp
-PC_OPTIONAL_LIBS := ccolamd camd colamd amd metis gomp quadmath
+PC_CLP_STATIC := -lClp -lCoinUtils -lbz2 -lz -lstdc++
+PC_OPTIONAL_LIBS := ccolamd camd colamd amd metis gomp quadmath bz2 z
 
 # $(call pc_has,module): non-empty when pkg-config knows the module
 pc_has = $(shell $(PKG_CONFIG) --exists $(1) 2>/dev/null && echo yes)
@@ -180,7 +207,8 @@ uniq_last = $(if $(1),$(if $(filter $(firstword $(1)),$(wordlist 2,$(words $(1))
 PC_REQUIRES_PRIVATE_ = $(foreach m,$(PC_MATH_MODULES),$(if $(call pc_has,$(m)),$(m)))
 PC_MATH_STATIC_      = $(foreach m,$(PC_MATH_MODULES),$(if $(filter $(m),$(REQUIRES_PRIVATE)),$(shell \
                            $(PKG_CONFIG) --static --libs-only-l $(m)),-l$(m))) -lm
-PC_STATIC_CANDIDATES_ = $(call uniq_last,$(if $(filter 1,$(HAVE_SUITESPARSE)),$(PC_SUITESPARSE_STATIC)) \
+PC_STATIC_CANDIDATES_ = $(call uniq_last,$(if $(filter 1,$(HAVE_CLP)),$(PC_CLP_STATIC)) \
+                           $(if $(filter 1,$(HAVE_SUITESPARSE)),$(PC_SUITESPARSE_STATIC)) \
                            $(PC_MATH_STATIC_) $(if $(filter -lgfortran,$(PC_MATH_STATIC_)),-lgfortran -lquadmath) \
                            -lpthread -lm)
 PC_STATIC_MISSING_   = $(foreach l,$(filter $(PC_OPTIONAL_LIBS:%=-l%),$(PC_STATIC_CANDIDATES)), \
@@ -203,7 +231,7 @@ SANFLAGS  ?=
 FAULTFLAGS ?=
 DEPFLAGS  := -MMD -MP
 
-ODHS_CPPFLAGS := -Iinclude -Ilib $(SUITESPARSE_CPPFLAGS) -DODHS_HAVE_LAPACKE=1 $(FAULTFLAGS)
+ODHS_CPPFLAGS := -Iinclude -Ilib $(SUITESPARSE_CPPFLAGS) $(CLP_CPPFLAGS) -DODHS_HAVE_LAPACKE=1 $(FAULTFLAGS)
 ODHS_CFLAGS   := -std=c11 $(OPTFLAGS) $(WARNFLAGS) $(SANFLAGS) -fPIC -fvisibility=hidden
 
 LIB_COMPILE = $(CC) $(ODHS_CPPFLAGS) $(CPPFLAGS) $(ODHS_CFLAGS) $(CFLAGS) $(DEPFLAGS)
@@ -572,14 +600,14 @@ ifeq ($(HAVE_SUITESPARSE),1)
 	@$(MAKE) --no-print-directory check-link-nos
 endif
 
-# SUITESPARSE=0 in build/link-nos (objects, libraries), installed into
+# SUITESPARSE=0 CLP=0 in build/link-nos (objects, libraries), installed into
 # build/link-nos/stage; linked with the pkg-config lines only.
 LINK_NOS := build/link-nos
 .PHONY: check-link-nos
 check-link-nos:
-	@echo "== building and installing a SUITESPARSE=0 libodhs into $(LINK_NOS)/stage (log: $(LINK_NOS)/build.log)"
+	@echo "== building and installing a SUITESPARSE=0 CLP=0 libodhs into $(LINK_NOS)/stage (log: $(LINK_NOS)/build.log)"
 	@mkdir -p $(LINK_NOS)
-	@$(MAKE) --no-print-directory install SUITESPARSE=0 BUILD=$(LINK_NOS) OUT_LIBDIR=$(LINK_NOS)/lib \
+	@$(MAKE) --no-print-directory install SUITESPARSE=0 CLP=0 BUILD=$(LINK_NOS) OUT_LIBDIR=$(LINK_NOS)/lib \
 	    DESTDIR= PREFIX=$(CURDIR)/$(LINK_NOS)/stage LIBDIR=$(CURDIR)/$(LINK_NOS)/stage/lib \
 	    INCLUDEDIR=$(CURDIR)/$(LINK_NOS)/stage/include PC_FILE=$(LINK_NOS)/stage-odhs.pc \
 	    > $(LINK_NOS)/build.log 2>&1 || { tail -n 30 $(LINK_NOS)/build.log; exit 1; }
@@ -763,7 +791,7 @@ fuzz-ci: fuzz
 # python3-venv, python3-wheel and python3-matplotlib: the Python bindings
 # (make python, make check-python: pytest, pip install into a venv, the
 # examples' plots).
-DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev \
+DEPS_PACKAGES := libsuitesparse-dev liblapacke-dev liblapack-dev libopenblas-dev coinor-libclp-dev \
                  check pkg-config gcc make \
                  clang libclang-rt-14-dev \
                  openmpi-bin libopenmpi-dev \
@@ -778,7 +806,8 @@ deps:
 	$$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update && \
 	$$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y $(DEPS_PACKAGES)
 
-# The CHOLMOD header is only required unless SUITESPARSE=0 was asked for.
+# The CHOLMOD and CLP headers are only required unless SUITESPARSE=0 or
+# CLP=0 was asked for.
 deps-if-missing:
 	@missing=; \
 	command -v $(PKG_CONFIG) >/dev/null 2>&1 || missing="$$missing pkg-config"; \
@@ -788,6 +817,8 @@ deps-if-missing:
 	done; \
 	if [ "$(filter 0 no off false,$(SUITESPARSE))" = "" ] && \
 	   [ ! -f $(SUITESPARSE_INC)/cholmod.h ]; then missing="$$missing cholmod.h"; fi; \
+	if [ "$(filter 0 no off false,$(CLP))" = "" ] && \
+	   [ ! -f $(CLP_INC)/Clp_C_Interface.h ]; then missing="$$missing Clp_C_Interface.h"; fi; \
 	if [ -n "$$missing" ]; then \
 	    echo "deps-if-missing: missing:$$missing -> running make deps"; \
 	    $(MAKE) --no-print-directory deps; \

@@ -59,6 +59,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/utsname.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -88,6 +90,10 @@ typedef struct {
                                     * overlap / d_ij, z without rattlers,
                                     * largest residual force              */
     uint64_t s_mins, s_iters; /* minimisations and FIRE iterations           */
+    /* table 4: lp = the fast route (odhs_stepper_jam_lp), lammps = LAMMPS
+     * doing the soft-sphere route (s_phi_lo/hi, s_mins) */
+    int lp, lammps;
+    odhs_jam_lp_report lprep;
 } result;
 
 static char solver_name[32] = "dense";
@@ -165,11 +171,147 @@ static void run_soft(result *r)
     free(xs);
 }
 
+/* ---- LAMMPS (Debian package lammps, binary lmp) doing the soft-sphere route ---- */
+/* The O'Hern protocol as a LAMMPS input: harmonic repulsion (pair granular,
+ * hooke, k_n = 1, no damping, no tangential force), the start compressed
+ * affinely to phi = 0.70 (2D; 0.50 in 3D), FIRE to |F| < 1e-14 (LAMMPS's ftol: the 2-norm of
+ * the global force vector), then steps of dphi = 1e-3 halved from the last
+ * unjammed state whenever the largest pair force after the minimisation
+ * exceeds 1e-10 (jammed), until dphi < 1e-6 phi. Prints "phi_unjammed
+ * phi_jammed minimisations" to the file ${out}. */
+static const char lammps_input[] =
+    "units lj\n"
+    "dimension ${dim}\n"
+    "boundary p p p\n"
+    "atom_style sphere\n"
+    "atom_modify map array\n"
+    "comm_modify vel yes\n"
+    "newton off\n"
+    "read_data ${data}\n"
+    "pair_style granular\n"
+    "pair_coeff * * hooke 1.0 0.0 tangential linear_nohistory 0.0 0.0\n"
+    "neighbor 0.3 bin\n"
+    "neigh_modify delay 0 every 1 check yes\n"
+    "timestep 0.05\n"
+    "compute rad all property/atom radius\n"
+    "variable va atom ${vfac}*c_rad^${dim}\n"
+    "compute sa all reduce sum v_va\n"
+    "variable phi equal c_sa/vol\n"
+    "compute pf all pair/local force\n"
+    "compute fm all reduce max c_pf\n"
+    "thermo_style custom step c_fm c_sa\n"
+    "thermo 1000000000\n"
+    "min_style fire\n"
+    "run 0 post no\n"
+    "variable s0 equal $((v_phi/v_phi0)^(1.0/v_dim))\n"
+    "change_box all @S0@ remap\n"
+    "minimize 0.0 1e-14 1000000 10000000\n"
+    "run 0 post no\n"
+    "variable phiu equal $(v_phi)\n"
+    "variable phih equal 1.0\n"
+    "variable dphi equal 1e-3\n"
+    "variable nmin equal 1\n"
+    "reset_timestep 0\n"
+    "write_dump all custom ${dump} id @XYZ@ modify sort id format float %.17g\n"
+    "label loop\n"
+    "variable s equal $((v_phiu/(v_phiu+v_dphi))^(1.0/v_dim))\n"
+    "change_box all @S@ remap\n"
+    "minimize 0.0 1e-14 1000000 10000000\n"
+    "run 0 post no\n"
+    "variable nmin equal $(v_nmin+1)\n"
+    "if \"$(c_fm) > 1e-10\" then \"variable phih equal $(v_phi)\" "
+    "\"read_dump ${dump} 0 @XYZ@ box yes replace yes\" \"variable dphi equal $(v_dphi*0.5)\" "
+    "else \"variable phiu equal $(v_phi)\" \"reset_timestep 0\" "
+    "\"write_dump all custom ${dump} id @XYZ@ modify sort id format float %.17g\"\n"
+    "if \"$(v_dphi) < $(1e-6*v_phiu)\" then \"jump SELF done\"\n"
+    "jump SELF loop\n"
+    "label done\n"
+    "print \"$(v_phiu:%.12f) $(v_phih:%.12f) $(v_nmin)\" file ${out}\n";
+
+static void run_lammps(result *r)
+{
+    double t0 = bench_wall();
+    struct rusage ru0, ru1;
+    getrusage(RUSAGE_CHILDREN, &ru0);
+    char dir[] = "/tmp/odhs_bench_lmp_XXXXXX", data[96], in[96], out[96], dump[96];
+    odhs_system *sys = NULL;
+    r->rc = mkdtemp(dir) ? odhs_system_create(r->dim, r->n, &sys) : ODHS_E_IO;
+    snprintf(data, sizeof data, "%s/start.data", dir);
+    snprintf(in, sizeof in, "%s/in.ohern", dir);
+    snprintf(out, sizeof out, "%s/result.txt", dir);
+    snprintf(dump, sizeof dump, "%s/unjammed.dump", dir);
+    if (!r->rc) r->rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, r->seed);
+    if (!r->rc) r->rc = odhs_system_place_random(sys, r->dim == 2 ? 0.45 : 0.30, r->seed + 1);
+    if (!r->rc) r->rc = odhs_lammps_data_write(sys, data);
+    /* the input with the dimension's scalings and coordinates filled in */
+    FILE *f = r->rc ? NULL : fopen(in, "w");
+    if (!r->rc && !f) r->rc = ODHS_E_IO;
+    for (const char *c = lammps_input; f && *c; ++c) {
+        const char *sub = NULL;
+        size_t skip = 0;
+        if (!strncmp(c, "@S0@", 4)) {
+            sub = r->dim == 2 ? "x scale ${s0} y scale ${s0}" : "x scale ${s0} y scale ${s0} z scale ${s0}";
+            skip = 4;
+        } else if (!strncmp(c, "@S@", 3)) {
+            sub = r->dim == 2 ? "x scale ${s} y scale ${s}" : "x scale ${s} y scale ${s} z scale ${s}";
+            skip = 3;
+        } else if (!strncmp(c, "@XYZ@", 5)) {
+            sub = r->dim == 2 ? "x y" : "x y z";
+            skip = 5;
+        }
+        if (sub) {
+            fputs(sub, f);
+            c += skip - 1;
+        } else {
+            fputc(*c, f);
+        }
+    }
+    if (f && (ferror(f) | fclose(f))) r->rc = ODHS_E_IO;
+    if (!r->rc) {
+        const int d = r->dim;
+        pid_t pid = fork();
+        if (pid == 0) {
+            char sdim[8], vfac[32];
+            snprintf(sdim, sizeof sdim, "%d", d);
+            snprintf(vfac, sizeof vfac, "%.17g", d == 2 ? 3.14159265358979323846 : 4.0 * 3.14159265358979323846 / 3.0);
+            execlp("lmp", "lmp", "-var", "dim", sdim, "-var", "phi0", d == 2 ? "0.70" : "0.50", "-var", "vfac", vfac, "-var", "data", data, "-var", "out", out,
+                   "-var", "dump", dump, "-in", in, "-log", "none", "-screen", "none", (char *)NULL);
+            _exit(127);
+        }
+        int status = 0;
+        if (pid < 0 || waitpid(pid, &status, 0) != pid) r->rc = ODHS_E_INTERNAL;
+        else if (WIFEXITED(status) && WEXITSTATUS(status) == 127) r->rc = ODHS_E_NOTINSTALLED;
+        else if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) r->rc = ODHS_E_CALLBACK;
+        FILE *g = r->rc ? NULL : fopen(out, "r");
+        unsigned long long nmin = 0;
+        if (!r->rc && (!g || fscanf(g, "%lf %lf %llu", &r->s_phi_lo, &r->s_phi_hi, &nmin) != 3)) r->rc = ODHS_E_FORMAT;
+        if (g) fclose(g);
+        r->s_mins = nmin;
+    }
+    getrusage(RUSAGE_CHILDREN, &ru1);
+    r->cpu = (double)(ru1.ru_utime.tv_sec - ru0.ru_utime.tv_sec + ru1.ru_stime.tv_sec - ru0.ru_stime.tv_sec) +
+             1e-6 * (double)(ru1.ru_utime.tv_usec - ru0.ru_utime.tv_usec + ru1.ru_stime.tv_usec - ru0.ru_stime.tv_usec);
+    r->wall = bench_wall() - t0;
+    r->cert.phi = r->s_phi_lo;
+    r->certified = 0;
+    r->done = 1;
+    remove(data);
+    remove(in);
+    remove(out);
+    remove(dump);
+    rmdir(dir);
+    odhs_system_destroy(sys);
+}
+
 /* the packing itself (runs in the child) */
 static void run_packing(result *r, int f0_check)
 {
     if (r->soft) {
         run_soft(r);
+        return;
+    }
+    if (r->lammps) {
+        run_lammps(r);
         return;
     }
     double t0 = bench_wall(), c0 = bench_cpu();
@@ -186,7 +328,8 @@ static void run_packing(result *r, int f0_check)
     if (!r->rc) r->rc = odhs_driver_set_compression_rate(drv, 1.0);
     if (!r->rc) r->rc = odhs_stepper_create(sys, drv, sol, &st);
     if (!r->rc) r->rc = odhs_stepper_set_correction_interval(st, correction);
-    if (!r->rc) r->rc = odhs_stepper_run_until_packing_fraction(st, 0.999);
+    r->lprep.size = sizeof r->lprep;
+    if (!r->rc) r->rc = r->lp ? odhs_stepper_jam_lp(st, NULL, &r->lprep) : odhs_stepper_run_until_packing_fraction(st, 0.999);
     r->wall = bench_wall() - t0;
     r->cpu = bench_cpu() - c0;
     if (st) {
@@ -424,6 +567,142 @@ static double estimate(double t0, size_t n0, size_t n, int dense)
     return t0 * pow((double)n / (double)n0, EXPONENT(dense));
 }
 
+/* ---- table 4: the routes side by side (issue 22) ------------------------------------ */
+/* ODHS_BENCH_ROUTE_SIZES (dim:N,...; default 2:256,2:1024,3:343,3:1000),
+ * ODHS_BENCH_ROUTE_SEEDS (seeds 1..S, default 5) and ODHS_BENCH_ROUTES (a
+ * comma list of lp, events, soft, lammps; default all four). Every run of
+ * a size starts from the same placements; LAMMPS is skipped (reported) when
+ * lmp is not installed. */
+enum { R_LP, R_EVENTS, R_SOFT, R_LAMMPS, R_N };
+static const char *const route_names[R_N] = {"lp", "events", "soft", "lammps"};
+
+static int table4(int workers, double limit)
+{
+    struct {
+        int dim;
+        size_t n;
+    } sizes[8] = {{2, 256}, {2, 1024}, {3, 343}, {3, 1000}};
+    int ns = 4;
+    const char *env = getenv("ODHS_BENCH_ROUTE_SIZES");
+    if (env && *env) {
+        ns = 0;
+        for (const char *q = env; *q && ns < 8;) {
+            int dd = 0, used = 0;
+            unsigned long nn = 0;
+            if (sscanf(q, "%d:%lu%n", &dd, &nn, &used) != 2 || (dd != 2 && dd != 3) || nn < 2) {
+                fprintf(stderr, "jamming: bad ODHS_BENCH_ROUTE_SIZES entry at \"%s\" (want dim:N,...)\n", q);
+                return 1;
+            }
+            sizes[ns].dim = dd;
+            sizes[ns].n = (size_t)nn;
+            ns++;
+            q += used;
+            if (*q == ',') q++;
+        }
+    }
+    const char *se = getenv("ODHS_BENCH_ROUTE_SEEDS");
+    int seeds = se && atoi(se) > 0 ? atoi(se) : 5;
+    if (seeds > 50) seeds = 50;
+    const char *re = getenv("ODHS_BENCH_ROUTES");
+    int want[R_N] = {1, 1, 1, 1};
+    if (re && *re)
+        for (int k = 0; k < R_N; ++k) want[k] = strstr(re, route_names[k]) != NULL;
+    result *runs = calloc((size_t)ns * R_N * (size_t)seeds, sizeof *runs);
+    if (!runs) return 1;
+    size_t nr = 0;
+    for (int z = 0; z < ns; ++z)
+        for (int k = 0; k < R_N; ++k)
+            for (int q = 0; q < seeds; ++q) {
+                result *r = &runs[nr++];
+                r->dim = sizes[z].dim;
+                r->n = sizes[z].n;
+                r->seed = (unsigned)(q + 1);
+                r->lp = k == R_LP;
+                r->soft = k == R_SOFT;
+                r->lammps = k == R_LAMMPS;
+                if (!want[k]) r->wall = -2.0; /* not asked for */
+            }
+    /* the pool skips nothing by itself: run the wanted ones, size by size */
+    for (size_t k = 0; k < nr; ++k) {
+        if (runs[k].wall == -2.0) continue;
+        size_t e = k;
+        while (e < nr && runs[e].wall != -2.0 && runs[e].dim == runs[k].dim && runs[e].n == runs[k].n) e++;
+        fprintf(stderr, "table 4: %dD N = %zu, %zu runs\n", runs[k].dim, runs[k].n, e - k);
+        run_pool(runs + k, e - k, workers, INFINITY, limit, 0);
+        k = e - 1;
+    }
+    printf("\n## Table 4: routes to a jammed packing side by side, the same %d starts per size (seeds 1-%d)\n"
+           "##   lp = odhs_stepper_jam_lp (chain of linear programmes + exact end game), events = event-driven\n"
+           "##   compression, soft = the library's soft-sphere route (table 3), lammps = LAMMPS (lmp) doing the\n"
+           "##   O'Hern protocol from phi 0.70 (3D: 0.50) (harmonic, FIRE to 1e-14, bisection to 1e-6). CPU s per packing;\n"
+           "##   ratio = route CPU / lp CPU. phi_J: certified packings for lp and events, the last unjammed phi\n"
+           "##   for the soft routes.\n",
+           seeds, seeds);
+    printf("%-3s %6s %-7s %5s %9s %10s %10s %11s %9s %8s %s\n", "d", "N", "route", "runs", "certified", "cpu_s",
+           "cpu_max", "phi_J", "phi_sd", "ratio", "work");
+    for (int z = 0; z < ns; ++z) {
+        double lp_cpu = NAN;
+        for (int k = 0; k < R_N; ++k) {
+            const result *rr = &runs[((size_t)z * R_N + (size_t)k) * (size_t)seeds];
+            if (rr[0].wall == -2.0) continue;
+            size_t run = 0, ok = 0, cert = 0;
+            double cpu = 0.0, cmax = 0.0, ph = 0.0, ph2 = 0.0;
+            unsigned long long work = 0;
+            int missing = 0;
+            for (int q = 0; q < seeds; ++q) {
+                const result *r = &rr[q];
+                if (r->wall < 0) continue;
+                run++;
+                if (r->lammps && r->rc == ODHS_E_NOTINSTALLED) missing = 1;
+                int good = r->done && (k == R_LP || k == R_EVENTS ? r->rc == ODHS_JAMMED : r->rc == ODHS_OK);
+                if (!good) continue;
+                ok++;
+                cert += (size_t)r->certified;
+                cpu += r->cpu;
+                cmax = fmax(cmax, r->cpu);
+                ph += r->cert.phi;
+                ph2 += r->cert.phi * r->cert.phi;
+                work += k == R_LP       ? r->lprep.n_lps
+                        : k == R_EVENTS ? r->steps
+                                        : r->s_mins;
+            }
+            if (missing) {
+                printf("%-3d %6zu %-7s skipped: lmp (Debian package lammps) is not installed\n", sizes[z].dim,
+                       sizes[z].n, route_names[k]);
+                continue;
+            }
+            if (!ok) {
+                printf("%-3d %6zu %-7s %5zu none finished (time limit %.0f s or failure)\n", sizes[z].dim, sizes[z].n,
+                       route_names[k], run, limit);
+                continue;
+            }
+            double m = (double)ok, mean = ph / m, sd = ok > 1 ? sqrt(fmax(0.0, (ph2 - m * mean * mean) / (m - 1))) : 0;
+            cpu /= m;
+            if (k == R_LP) lp_cpu = cpu;
+            char cs[16];
+            if (k == R_LP || k == R_EVENTS) snprintf(cs, sizeof cs, "%zu/%zu", cert, run);
+            else snprintf(cs, sizeof cs, "-");
+            printf("%-3d %6zu %-7s %5zu %9s %10.2f %10.2f %11.6f %9.5f %8.2f %llu %s\n", sizes[z].dim, sizes[z].n,
+                   route_names[k], run, cs, cpu, cmax, mean, sd, cpu / lp_cpu, work / (unsigned long long)ok,
+                   k == R_LP ? "programmes" : k == R_EVENTS ? "steps" : "minimisations");
+            if (csv)
+                fprintf(csv, "routes,%d,%zu,%zu,%zu,%zu,%.9f,%.3e,,,,,%.2f,%.2f,%llu,,,,,,%s\n", sizes[z].dim,
+                        sizes[z].n, run, ok, cert, mean, sd, cpu, cmax, work / (unsigned long long)ok,
+                        route_names[k]);
+        }
+    }
+    if (csv)
+        for (size_t k = 0; k < nr; ++k) {
+            const result *r = &runs[k];
+            if (r->wall < 0) continue;
+            fprintf(csv, "run:routes,%d,%zu,seed %u,rc %d,%s,%d,%.12f,,,,,%.2f,%.2f,,,,,,,%s\n", r->dim, r->n, r->seed,
+                    r->rc, r->lp ? "lp" : r->soft ? "soft" : r->lammps ? "lammps" : "events", r->certified,
+                    r->cert.phi, r->wall, r->cpu, r->done ? "" : "killed at the time limit");
+        }
+    free(runs);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     double t_start = bench_wall();
@@ -477,7 +756,9 @@ int main(int argc, char **argv)
     const char *tabs = getenv("ODHS_BENCH_TABLES");
     if (!tabs || !*tabs) tabs = "123";
     int do1 = strchr(tabs, '1') != NULL, do2 = strchr(tabs, '2') != NULL, do3 = strchr(tabs, '3') != NULL;
-    printf("# tables: %s%s%s (ODHS_BENCH_TABLES)\n", do1 ? "1 " : "", do2 ? "2 " : "", do3 ? "3" : "");
+    int do4 = strchr(tabs, '4') != NULL;
+    printf("# tables: %s%s%s%s (ODHS_BENCH_TABLES)\n", do1 ? "1 " : "", do2 ? "2 " : "", do3 ? "3 " : "",
+           do4 ? "4" : "");
 
     /* ---- pilot: one small packing per dimension, to size the plan ---------- */
     result pilot[2];
@@ -729,6 +1010,7 @@ int main(int argc, char **argv)
                         q->s_overlap, q->rc ? odhs_strerror(q->rc) : "");
         }
     }
+    if (do4 && table4(workers, soft_limit)) return 2;
     if (csv) fclose(csv);
     printf("\n# total %.0f s\n", bench_wall() - t_start);
     return 0;

@@ -18,6 +18,9 @@
 /* --protocol */
 enum { COMPRESS, SHEAR, SHEAR_COMPRESS, PRESSURE };
 static const char *const protocols[] = {"compress", "shear", "shear+compress", "pressure", NULL};
+/* --method */
+enum { EVENTS, LP };
+static const char *const methods[] = {"events", "lp", NULL};
 
 /* the integration settings of the options */
 static int configure(odhs_stepper *st, int integrator, double dt, double tol, unsigned long corr)
@@ -68,16 +71,39 @@ static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, do
     return ODHS_OK;
 }
 
+/* --method lp: the chain of linear programmes and the exact end game */
+static int jam_lp(odhs_stepper *st, double trust, int quiet)
+{
+    odhs_jam_lp_options o = {.size = sizeof o, .trust = trust};
+    odhs_jam_lp_report r = {.size = sizeof r};
+    int rc = odhs_stepper_jam_lp(st, &o, &r);
+    if (!quiet && rc == ODHS_JAMMED)
+        fprintf(stderr,
+                "jam_packing: %zu linear programmes (%llu simplex iterations, at most %zu pairs), phi = %.12f; "
+                "end game: %llu event-driven steps\n",
+                r.n_lps, (unsigned long long)r.simplex_iterations, r.rows_max, r.phi_lp,
+                (unsigned long long)r.end_steps);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double dt = 1e-3, max_strain = 20.0, tol = 1e-6, p_jam = 0.0, traj_every = 0.01;
-    int protocol = COMPRESS, integrator = CLI_DEFAULT_INTEGRATOR, dim = 2, quiet = 0;
+    double dt = 1e-3, max_strain = 20.0, tol = 1e-6, p_jam = 0.0, traj_every = 0.01, trust = 0.1;
+    int protocol = COMPRESS, method = EVENTS, integrator = CLI_DEFAULT_INTEGRATOR, dim = 2, quiet = 0;
     unsigned long corr = 1;
     unsigned long n = 256, seed = 1;
     const cli_opt opts[] = {
         CLI_OPT_LIST("--protocol", &protocol, "P", "compress | shear | shear+compress | pressure", protocols, CLI_ANY),
+        CLI_OPT_LIST("--method", &method, "M",
+                     "how the compression stage (compress, shear) jams: events = the event-driven compression; lp = "
+                     "a chain of linear programmes, then the same exact end game (odhs_stepper_jam_lp; needs a "
+                     "library built with COIN-OR CLP)",
+                     methods, CLI_ANY),
+        CLI_OPT_DOUBLE("--trust", &trust, "X",
+                       "--method lp: bound on each displacement per programme, in mean diameters (at most 0.5)",
+                       CLI_POSITIVE),
         CLI_IN(&in),
         CLI_OUT(&outpath),
         CLI_CONTACTS(&contacts),
@@ -122,6 +148,15 @@ int main(int argc, char **argv)
         0};
     int rc = cli_parse(&cli, argc, argv);
     if (rc != CLI_GO) return rc;
+    if (method == LP && (protocol == SHEAR_COMPRESS || protocol == PRESSURE)) {
+        fprintf(stderr, "jam_packing: --method lp replaces an isotropic compression to jamming: protocols compress "
+                        "and shear only\n");
+        return 2;
+    }
+    if (trust > 0.5) {
+        fprintf(stderr, "jam_packing: --trust %g: at most 0.5\n", trust);
+        return 2;
+    }
 
     odhs_system *sys = NULL;
     if (cli_start(cli.prog, in, dim, n, seed, 1.0, &sys)) return 1;
@@ -136,8 +171,8 @@ int main(int argc, char **argv)
         return 1;
     }
     if (!quiet)
-        fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, solver %s, %s\n", n, odhs_system_dim(sys),
-                protocols[protocol], solver_name, cli_integrators[integrator]);
+        fprintf(stderr, "jam_packing: N = %lu, d = %d, protocol %s, method %s, solver %s, %s\n", n,
+                odhs_system_dim(sys), protocols[protocol], methods[method], solver_name, cli_integrators[integrator]);
     frames fr = {.sys = sys, .st = st, .shear = protocol == SHEAR || protocol == PRESSURE};
     if ((rc = cli_traj_open(&fr.traj, cli.prog, traj, traj_contacts, traj_every))) return rc;
     if (traj || traj_contacts) {
@@ -149,10 +184,10 @@ int main(int argc, char **argv)
 
     if (protocol == COMPRESS) {
         odhs_driver_set_compression_rate(drv, 1.0);
-        rc = drive(st, drv, 0, 0, 0);
+        rc = method == LP ? jam_lp(st, trust, quiet) : drive(st, drv, 0, 0, 0);
     } else if (protocol == SHEAR) {
         odhs_driver_set_compression_rate(drv, 1.0);
-        rc = drive(st, drv, 0, 0, 0);
+        rc = method == LP ? jam_lp(st, trust, quiet) : drive(st, drv, 0, 0, 0);
         if (rc == ODHS_JAMMED) {
             /* dilate slightly (all contacts open) and shear at fixed volume */
             double phi;

@@ -1000,6 +1000,48 @@ static void jam_final(af_fix *f, const af_scenario *sc)
     AF_ASSERT(odhs_stepper_step(f->st, NULL) == ODHS_JAMMED);
 }
 
+/* -- jam_lp: the fast route (odhs_stepper_jam_lp) from cfg_dense: the chain
+ *    of programmes (only the library's own allocations are walked, not CLP's),
+ *    the reset on the packing, the certificate ---------------------------- */
+#if ODHS_HAVE_CLP
+static int jam_lp_op(af_fix *f, const af_scenario *sc, int k)
+{
+    (void)sc;
+    switch (k) {
+    case 0: return odhs_driver_create(&f->drv);
+    case 1: return odhs_driver_set_compression_rate(f->drv, 1.0);
+    case 2: return odhs_solver_create_by_name("dense", &f->sol);
+    case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
+    case 4: return odhs_stepper_reset(f->st);
+    case 5: return odhs_stepper_jam_lp(f->st, NULL, NULL);
+    case 6: f->cert.size = sizeof f->cert; return odhs_stepper_certificate(f->st, &f->cert);
+    }
+    return ODHS_E_INTERNAL;
+}
+
+static void jam_lp_setup(af_fix *f, const af_scenario *sc)
+{
+    (void)sc;
+    f->sys = config_system(&cfg_dense);
+}
+
+static void jam_lp_capture(const af_fix *f, const af_scenario *sc, int op, af_buf *b)
+{
+    (void)sc;
+    rec_system(b, "sys", f->sys);
+    rec_i(b, "handles", (f->drv != NULL) + 2 * (f->sol != NULL));
+    rec_stepper(b, f->st);
+    if (op < 0) rec(b, "cert", 'c', &f->cert, sizeof f->cert);
+}
+
+static void jam_lp_final(af_fix *f, const af_scenario *sc)
+{
+    stepper_final(f, sc->name, 1e-12);
+    AF_ASSERT(f->cert.jammed == 1 && f->cert.isostatic == 1 && f->cert.min_force > 0.0);
+    AF_ASSERT(odhs_stepper_step(f->st, NULL) == ODHS_JAMMED);
+}
+#endif
+
 /* -- files: contacts file and SVG picture ----------------------------------- */
 static void files_setup(af_fix *f, const af_scenario *sc)
 {
@@ -1459,6 +1501,9 @@ static const af_scenario scenarios[] = {
     {"shear_pressure_high", SH_NOPS, 5, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_callback", SH_NOPS, 6, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
+#if ODHS_HAVE_CLP
+    {"jam_lp", 7, 0, jam_lp_setup, NULL, jam_lp_op, jam_lp_capture, jam_lp_final},
+#endif
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"analysis", 6, 0, analysis_setup, NULL, analysis_op, analysis_capture, files_final},
     {"outputs", 8, 0, outputs_setup, NULL, outputs_op, outputs_capture, outputs_final},

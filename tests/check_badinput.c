@@ -1873,7 +1873,27 @@ static int huge_rate_case(void)
     X(contacts_unset, odhs_contacts_write, ODHS_E_STATE, NOALT, H_NET2, 0,                                     \
       return odhs_contacts_write(w->net2, w->bare, wpath(w, "c.txt"));)                                        \
     X(contacts_nowhere, odhs_contacts_write, ODHS_E_IO, NOALT, H_NET2, 0,                                      \
-      return odhs_contacts_write(w->net2, w->sys2, NOWHERE);)
+      return odhs_contacts_write(w->net2, w->sys2, NOWHERE);)                                                  \
+    X(jam_lp_null, odhs_stepper_jam_lp, ODHS_E_NULL, NOALT, H_NONE, 0,                                         \
+      return odhs_stepper_jam_lp(NULL, NULL, NULL);)                                                           \
+    X(jam_lp_shear_driver, odhs_stepper_jam_lp, ODHS_E_STATE, NOALT, H_RUN, 0,                                 \
+      /* the run's driver shears: the fast route compresses only */ return odhs_stepper_jam_lp(w->run,         \
+      NULL, NULL);)                                                                                            \
+    X(jam_lp_never_stepped, odhs_stepper_jam_lp, ODHS_E_STATE, NOALT, H_ST, 0,                                 \
+      /* refused before the stepper is reset */ return odhs_stepper_jam_lp(w->st, NULL, NULL);)                \
+    X(jam_lp_opt_size0, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                                  \
+      odhs_jam_lp_options o; memset(&o, 0, sizeof o); return odhs_stepper_jam_lp(w->run, &o, NULL);)           \
+    X(jam_lp_rep_size0, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                                  \
+      odhs_jam_lp_report r; memset(&r, 0, sizeof r); return odhs_stepper_jam_lp(w->run, NULL, &r);)            \
+    X(jam_lp_trust_nan, odhs_stepper_jam_lp, ODHS_E_NONFINITE, NOALT, H_RUN, 0,                                \
+      odhs_jam_lp_options o = {.size = sizeof o, .trust = NAN_}; return odhs_stepper_jam_lp(w->run, &o,        \
+      NULL);)                                                                                                  \
+    X(jam_lp_trust_big, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                                  \
+      odhs_jam_lp_options o = {.size = sizeof o, .trust = 0.9}; return odhs_stepper_jam_lp(w->run, &o,         \
+      NULL);)                                                                                                  \
+    X(jam_lp_tol_negative, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                               \
+      odhs_jam_lp_options o = {.size = sizeof o, .tol = -1e-12}; return odhs_stepper_jam_lp(w->run, &o,        \
+      NULL);)
 
 /* ---- traj.h, lammps.h and the outputs of 0.2.6 in io.h and stepper.h ------------------ */
 /* a trajectory of the given format in the world's directory (NULL: none) */

@@ -966,24 +966,34 @@ static const jam_case pack_cases[] = {
 };
 #define N_PACK_CASES ((int)(sizeof pack_cases / sizeof pack_cases[0]))
 
+/* how a packing is made */
+enum { JAM_DEFAULT, JAM_PAPER, JAM_LP };
+
 /* One packing: the run must end with ODHS_JAMMED, the certificate must pass,
- * and the independent recomputation must agree. paper = 1: the paper's
+ * and the independent recomputation must agree. mode JAM_PAPER: the paper's
  * scheme instead of the defaults (jam_packing --integrator euler --dt 1e-3
- * --correction 10). *pivots (if not NULL) receives the certificate's
- * n_pivots. */
-static void packing_certified(const jam_case *jc, int paper, size_t *pivots)
+ * --correction 10); JAM_LP: the fast route (odhs_stepper_jam_lp, jam_packing
+ * --method lp; protocol compress). *pivots (if not NULL) receives the
+ * certificate's n_pivots, *phi (if not NULL) phi_J (NAN if not jammed). */
+static void packing_certified_by(const jam_case *jc, int mode, size_t *pivots, double *phi)
 {
     /* failures are collected and asserted after everything is freed, so that
      * the sanitizer run (CK_FORK=no) reports only the failure, not leaks */
     jrun r;
     jrun_start(&r, jc->dim, jc->n, jc->seed, jc->protocol, "default");
-    if (paper) {
+    if (mode == JAM_PAPER) {
         CHECK_OK(odhs_stepper_set_integrator(r.st, ODHS_INTEGRATOR_EULER));
         CHECK_OK(odhs_stepper_set_dt(r.st, 1e-3));
         CHECK_OK(odhs_stepper_set_correction_interval(r.st, 10));
     }
-    jrun_drive(&r);
+    if (mode == JAM_LP) {
+        jrun_configure(&r);
+        r.rc = odhs_stepper_jam_lp(r.st, NULL, NULL);
+    } else {
+        jrun_drive(&r);
+    }
     if (pivots) *pivots = SIZE_MAX;
+    if (phi) *phi = NAN;
     char head[160], cmsg[512], imsg[768], fail[2048] = "";
     snprintf(head, sizeof head, "%dD N = %zu seed %llu %s", r.dim, r.n, (unsigned long long)r.seed, r.protocol);
     if (r.rc != ODHS_JAMMED) {
@@ -994,6 +1004,7 @@ static void packing_certified(const jam_case *jc, int paper, size_t *pivots)
         c.size = sizeof c;
         CHECK_OK(odhs_stepper_certificate(r.st, &c));
         if (pivots) *pivots = c.n_pivots;
+        if (phi) *phi = c.phi;
         cert_print(cmsg, sizeof cmsg, &c);
         int ind = independent_check(&r, imsg, sizeof imsg);
         /* f0 recomputed on the final network is the stored force field */
@@ -1023,9 +1034,162 @@ static void packing_certified(const jam_case *jc, int paper, size_t *pivots)
     ck_assert_msg(fail[0] == '\0', "%s", fail);
 }
 
+static void packing_certified(const jam_case *jc, int paper, size_t *pivots)
+{
+    packing_certified_by(jc, paper ? JAM_PAPER : JAM_DEFAULT, pivots, NULL);
+}
+
 START_TEST(test_packing_certified)
 {
     packing_certified(&pack_cases[_i], 0, NULL);
+}
+END_TEST
+
+/* ========================================================================== */
+/* The fast route: a chain of linear programmes, then the exact end game      */
+/* ========================================================================== */
+
+#if ODHS_HAVE_CLP
+static const jam_case lp_cases[] = {
+    {2, 64, 1, "compress"}, {2, 64, 2, "compress"}, {2, 64, 3, "compress"}, {2, 256, 1, "compress"},
+    {3, 64, 1, "compress"}, {3, 64, 2, "compress"}, {3, 128, 1, "compress"},
+};
+
+/* odhs_stepper_jam_lp's packings pass the certificate and the independent
+ * recomputation (jam_packing --method lp) */
+START_TEST(test_lp_certified)
+{
+    packing_certified_by(&lp_cases[_i], JAM_LP, NULL, NULL);
+}
+END_TEST
+
+/* The two routes are different protocols (the programmes move particles by
+ * up to 0.1 diameters at a time, not along the overdamped dynamics), so they
+ * jam the same start at different phi_J. Their distributions must agree:
+ * 2D N = 64, the same 12 starts, means within 3 standard errors of their
+ * difference, and every packing certified. */
+START_TEST(test_lp_phi_statistics)
+{
+    enum { SEEDS = 12 };
+    double a[SEEDS], b[SEEDS], ma = 0.0, mb = 0.0, va = 0.0, vb = 0.0;
+    for (int k = 0; k < SEEDS; ++k) {
+        jam_case jc = {2, 64, 100 + (uint64_t)k, "compress"};
+        packing_certified_by(&jc, JAM_LP, NULL, &a[k]);
+        packing_certified_by(&jc, JAM_DEFAULT, NULL, &b[k]);
+        ma += a[k] / SEEDS;
+        mb += b[k] / SEEDS;
+    }
+    for (int k = 0; k < SEEDS; ++k) {
+        va += (a[k] - ma) * (a[k] - ma) / (SEEDS - 1);
+        vb += (b[k] - mb) * (b[k] - mb) / (SEEDS - 1);
+    }
+    double se = sqrt(va / SEEDS + vb / SEEDS);
+    ck_assert_msg(fabs(ma - mb) < 3.0 * se && se > 0.0 && se < 0.01,
+                  "phi_J: LP %.5f +- %.5f, events %.5f +- %.5f (standard deviations %.4f, %.4f)", ma,
+                  sqrt(va / SEEDS), mb, sqrt(vb / SEEDS), sqrt(va), sqrt(vb));
+}
+END_TEST
+
+/* A Lees-Edwards box at strain 0.3: the programmes see the sheared images */
+START_TEST(test_lp_lees_edwards)
+{
+    jrun r;
+    jrun_start(&r, 2, 128, 5, "compress", "default");
+    CHECK_OK(odhs_driver_set_shear_rate(r.drv, 1.0));
+    CHECK_OK(odhs_stepper_run_until_strain(r.st, 0.3));
+    CHECK_OK(odhs_driver_set_shear_rate(r.drv, 0.0));
+    jrun_configure(&r);
+    r.rc = odhs_stepper_jam_lp(r.st, NULL, NULL);
+    char msg[768] = "";
+    int ok = r.rc == ODHS_JAMMED && independent_check(&r, msg, sizeof msg);
+    double g;
+    CHECK_OK(odhs_system_get_strain(r.sys, &g));
+    int rc = r.rc;
+    jrun_free(&r);
+    ck_assert_msg(ok && fabs(g - 0.3) < 1e-15, "status %d, strain %.17g: %s", rc, g, msg);
+}
+END_TEST
+
+/* The report; a run cut short (one programme, one step of the end game)
+ * returns ODHS_E_STALLED at the state it reached, from which a second call
+ * jams */
+START_TEST(test_lp_report_and_stall)
+{
+    jrun r;
+    jrun_start(&r, 2, 64, 2, "compress", "default");
+    jrun_configure(&r);
+    double phi0, phi1;
+    CHECK_OK(odhs_system_packing_fraction(r.sys, &phi0));
+    odhs_jam_lp_options o = {.size = sizeof o, .max_lps = 1, .max_steps = 1};
+    odhs_jam_lp_report rep = {.size = sizeof rep};
+    ck_assert_int_eq(odhs_stepper_jam_lp(r.st, &o, &rep), ODHS_E_STALLED);
+    ck_assert_msg(strstr(odhs_stepper_errmsg(r.st), "end game") != NULL, "%s", odhs_stepper_errmsg(r.st));
+    CHECK_OK(odhs_system_packing_fraction(r.sys, &phi1));
+    ck_assert_msg(rep.n_lps == 1 && rep.end_steps == 1 && rep.growth_last > 1e-3 && phi1 > phi0 &&
+                      fabs(rep.phi_lp - phi1) < 0.01,
+                  "%zu programmes, %llu steps, growth %.3e, phi %.6f -> %.6f (report %.6f)", rep.n_lps,
+                  (unsigned long long)rep.end_steps, rep.growth_last, phi0, phi1, rep.phi_lp);
+    /* the full run: the report describes it */
+    ck_assert_int_eq(odhs_stepper_jam_lp(r.st, NULL, &rep), ODHS_JAMMED);
+    odhs_jam_certificate c = {.size = sizeof c};
+    CHECK_OK(odhs_stepper_certificate(r.st, &c));
+    ck_assert_msg(rep.n_lps >= 3 && rep.simplex_iterations >= rep.n_lps && rep.rows_max >= c.n_contacts &&
+                      rep.growth_last < 1e-12 && fabs(rep.phi_lp - c.phi) < 1e-9 && rep.end_steps < 100 &&
+                      c.jammed && c.isostatic,
+                  "%zu programmes, %llu iterations, %zu rows, growth %.3e, phi %.15f (certificate %.15f), %llu "
+                  "steps",
+                  rep.n_lps, (unsigned long long)rep.simplex_iterations, rep.rows_max, rep.growth_last, rep.phi_lp,
+                  c.phi, (unsigned long long)rep.end_steps);
+    /* jammed: nothing to do */
+    ck_assert_int_eq(odhs_stepper_jam_lp(r.st, NULL, NULL), ODHS_JAMMED);
+    jrun_free(&r);
+}
+END_TEST
+#endif
+
+/* What the fast route refuses (with or without the LP solver built in) */
+START_TEST(test_lp_requirements)
+{
+    jrun r;
+    jrun_start(&r, 2, 64, 1, "compress", "default");
+    /* no compression */
+    ck_assert_int_eq(odhs_stepper_jam_lp(r.st, NULL, NULL), ODHS_E_STATE);
+    ck_assert(strstr(odhs_stepper_errmsg(r.st), "compression") != NULL);
+    CHECK_OK(odhs_driver_set_shear_rate(r.drv, 1.0));
+    CHECK_OK(odhs_driver_set_compression_rate(r.drv, 1.0));
+    ck_assert_int_eq(odhs_stepper_jam_lp(r.st, NULL, NULL), ODHS_E_STATE);
+    CHECK_OK(odhs_driver_set_shear_rate(r.drv, 0.0));
+    /* walls: a short segment in a hole of the scene */
+    double x[128], rad[64], L[3], c[2] = {0, 0}, best = -1.0;
+    CHECK_OK(odhs_system_get_positions(r.sys, x));
+    CHECK_OK(odhs_system_get_radii(r.sys, rad));
+    CHECK_OK(odhs_system_get_box(r.sys, L));
+    for (int a = 0; a < 40; ++a)
+        for (int b = 0; b < 40; ++b) {
+            double p[2] = {L[0] * (a + 0.5) / 40, L[1] * (b + 0.5) / 40}, clear = INFINITY;
+            for (size_t i = 0; i < 64; ++i) {
+                double dv[3] = {p[0] - x[2 * i], p[1] - x[2 * i + 1], 0};
+                clear = fmin(clear, sqrt(tu_min_image_brute(2, L, 0.0, dv, NULL, NULL)) - rad[i]);
+            }
+            if (clear > best) best = clear, c[0] = p[0], c[1] = p[1];
+        }
+    ck_assert(best > 0.05);
+    size_t id;
+    double ea[2] = {c[0] - 0.01, c[1]}, eb[2] = {c[0] + 0.01, c[1]};
+    CHECK_OK(odhs_stepper_add_wall_segment(r.st, ea, eb, &id));
+    ck_assert_int_eq(odhs_stepper_jam_lp(r.st, NULL, NULL), ODHS_E_UNSUPPORTED);
+    ck_assert(strstr(odhs_stepper_errmsg(r.st), "walls") != NULL);
+    jrun_free(&r);
+    jrun_start(&r, 2, 64, 1, "compress", "default");
+    jrun_configure(&r);
+    int rc = odhs_stepper_jam_lp(r.st, NULL, NULL);
+#if ODHS_HAVE_CLP
+    ck_assert_int_eq(rc, ODHS_JAMMED);
+#else
+    ck_assert_int_eq(rc, ODHS_E_NOTINSTALLED);
+    ck_assert(strstr(odhs_stepper_errmsg(r.st), "CLP") != NULL);
+#endif
+    jrun_free(&r);
 }
 END_TEST
 
@@ -2265,6 +2429,18 @@ Suite *make_jamming_suite(void)
     tc = tcase_create("packings");
     tcase_set_timeout(tc, 600);
     tcase_add_loop_test(tc, test_packing_certified, 0, N_PACK_CASES);
+    suite_add_tcase(s, tc);
+
+    /* the fast route (odhs_stepper_jam_lp) */
+    tc = tcase_create("lp");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, test_lp_requirements);
+#if ODHS_HAVE_CLP
+    tcase_add_loop_test(tc, test_lp_certified, 0, (int)(sizeof lp_cases / sizeof lp_cases[0]));
+    tcase_add_test(tc, test_lp_phi_statistics);
+    tcase_add_test(tc, test_lp_lees_edwards);
+    tcase_add_test(tc, test_lp_report_and_stall);
+#endif
     suite_add_tcase(s, tc);
     return s;
 }

@@ -93,6 +93,22 @@ head -c 4 "$tmp/j.svg" | grep -q "<svg" && pass=$((pass + 1)) || { echo "FAIL: j
 expect 3 "shear_flow on a jammed packing stops early" -- "$bin/shear_flow" --in "$tmp/j.xyz" --strain 0.1 --solver dense
 expect_in err "^shear_flow: stopped at strain" "shear_flow says why it stopped, on a line of its own"
 expect 2 "jam_packing negative --jam-pressure" -- "$bin/jam_packing" --jam-pressure -1
+# the fast route (--method lp): certified, or a clear refusal from a library built without CLP
+"$bin/jam_packing" --n 64 --method lp --contacts "$tmp/jlp.con" >"$tmp/out" 2>"$tmp/err"
+got=$?
+if grep -q "built without an LP solver" "$tmp/err"; then
+    echo "examples-cli: jam_packing --method lp skipped: the library has no LP solver (CLP)"
+elif [ "$got" -eq 0 ] && grep -q "^certified              yes" "$tmp/out" && grep -q "linear programmes" "$tmp/err" \
+    && [ "$(wc -l < "$tmp/jlp.con")" -gt 64 ]; then
+    pass=$((pass + 1))
+else
+    echo "FAIL: jam_packing --method lp: exit $got"; sed 's/^/  | /' "$tmp/err" | tail -5; fail=$((fail + 1))
+fi
+expect 2 "jam_packing --method lp refuses a protocol without a compression stage" -- \
+    "$bin/jam_packing" --method lp --protocol pressure
+expect_in err "compress and shear only" "jam_packing says which protocols --method lp takes"
+expect 2 "jam_packing --trust beyond half a diameter" -- "$bin/jam_packing" --method lp --trust 0.7
+expect 2 "jam_packing bad method" -- "$bin/jam_packing" --method simplex
 head -1 "$tmp/j.con" | grep -q "^i,j,kind,force,gap$" && [ "$(awk -F, 'NR > 1 && NF != 5' "$tmp/j.con" | wc -l)" -eq 0 ] \
     && pass=$((pass + 1)) || { echo "FAIL: jam_packing contacts CSV"; fail=$((fail + 1)); }
 expect 0 "composite help" -- "$bin/composite" --help

@@ -75,6 +75,81 @@ typedef struct odhs_jam_certificate {
 /** Fill a certificate for the stepper's current state (jammed or not). */
 ODHS_API int odhs_stepper_certificate(const odhs_stepper *st, odhs_jam_certificate *cert);
 
+/* ---- the fast route (since 0.2.9) ----------------------------------------- */
+
+/**
+ * Settings of odhs_stepper_jam_lp. Set `size` to sizeof(odhs_jam_lp_options);
+ * a field left 0 takes its default.
+ */
+typedef struct odhs_jam_lp_options {
+    size_t size;      /* in: sizeof(odhs_jam_lp_options)                           */
+    double trust;     /* bound on each displacement component per programme, in
+                       * mean diameters, in (0, 0.5] (default 0.1)                  */
+    double tol;       /* the chain ends when sqrt(Gamma) - 1 < tol (default 1e-12)  */
+    size_t max_lps;   /* programmes at most (default 10000)                         */
+    size_t max_steps; /* event-driven steps of the end game at most (default 1e5)   */
+} odhs_jam_lp_options;
+
+/** What odhs_stepper_jam_lp did. Set `size` to sizeof(odhs_jam_lp_report). */
+typedef struct odhs_jam_lp_report {
+    size_t size;                 /* in: sizeof(odhs_jam_lp_report)               */
+    size_t n_lps;                /* linear programmes solved                      */
+    uint64_t simplex_iterations; /* dual simplex iterations over all of them      */
+    size_t rows_max;             /* largest number of pair constraints            */
+    double phi_lp;               /* packing fraction at the end of the chain      */
+    double growth_last;          /* sqrt(Gamma) - 1 of the last programme         */
+    uint64_t end_steps;          /* event-driven steps of the end game (usually 0) */
+} odhs_jam_lp_report;
+
+/**
+ * The fast route to a certified jammed packing: compress the stepper's
+ * system to jamming by a chain of linear programmes, then finish with the
+ * stepper's exact end game, and return ODHS_JAMMED with the packing in the
+ * stepper (its network, forces and odhs_stepper_certificate exactly as after
+ * a compression run that returned ODHS_JAMMED).
+ *
+ * Each programme maximises the growth Gamma of the squared contact
+ * distances over displacements s (|s_i,a| <= trust mean diameters) subject
+ * to the contact constraints linearised around the configuration,
+ * |r_ij|^2 + 2 r_ij.(s_j - s_i) >= Gamma sigma_ij^2 for every pair that
+ * could touch (sequential linear programming: Torquato & Jiao 2010;
+ * CALiPPSO, Artiaco et al. 2022). The linearisation underestimates the real
+ * distances, so no step overlaps; the configuration moves by s and the box
+ * shrinks by the growth the real pairs allow. At the end (sqrt(Gamma) - 1 <
+ * tol) the programme's active pairs are the jammed network: the stepper is
+ * reset on the configuration, takes the touching pairs (its contact
+ * tolerance) as its network, and steps under the compression until
+ * ODHS_JAMMED (normally at once), with the rewiring, self-stress, polish and
+ * final pivots of a compression run.
+ *
+ * A different protocol from the event-driven compression: the programmes
+ * move particles by up to `trust` at a time, not along the overdamped
+ * dynamics, so from the same start the two give different packings (and
+ * different phi_J within their spread). The stepper's time advances only
+ * by the end game's steps. Programmes are solved by COIN-OR CLP's dual
+ * simplex (a build without it returns ODHS_E_NOTINSTALLED), each warm
+ * started from the basis of the one before; CLP's own allocations are not
+ * the library's (an allocation failure inside CLP is not reported as
+ * ODHS_E_NOMEM).
+ *
+ * Requirements: the driver compresses only (compression rate > 0; no
+ * shear, pressure, forces, callback, propulsion or gravity: ODHS_E_STATE
+ * otherwise), the scene has no walls or bonds (ODHS_E_UNSUPPORTED), and the
+ * stepper is not jammed (ODHS_JAMMED with a message). A stepper that needs a
+ * reset is reset first, as odhs_stepper_step does. opt may be NULL (all
+ * defaults), rep may be NULL (it is filled when the call gets to the end
+ * game).
+ *
+ * Errors: the programmes run on private copies of the configuration, so an
+ * error there (ODHS_E_NOMEM; ODHS_E_NOCONV when the LP solver stops without
+ * an optimum; ODHS_E_BOX when the box is too small for the cut-off) and a
+ * failed reset on the packing leave the stepper and its system as they were.
+ * The end game's steps are steps: one that fails is undone, the ones before
+ * it stay (as in odhs_stepper_run_until_*), and ODHS_E_STALLED after
+ * max_steps leaves the state reached.
+ */
+ODHS_API int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_jam_lp_report *rep);
+
 /* odhs_contacts_write (the contacts file) is declared in odhs/io.h. */
 
 #ifdef __cplusplus

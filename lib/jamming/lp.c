@@ -1,0 +1,419 @@
+/* libodhs - the fast route to a certified jammed packing (issue 22): a chain
+ * of linear programmes brings the configuration to a jammed packing, and the
+ * stepper's exact end game (rewiring, self-stress, polish, pivots:
+ * lib/stepper/endgame.c) certifies it.
+ *
+ * Each programme linearises the contact constraints around the current
+ * configuration x (the idea of Torquato & Jiao, PRE 82, 061302 (2010), and
+ * of CALiPPSO, Artiaco, Diaz Hernandez Rojas, Parisi & Ricci-Tersenghi, PRE
+ * 106, 055310 (2022)): with displacements s_i and a growth factor Gamma of
+ * the squared contact distances,
+ *
+ *     maximise Gamma  subject to  |r_ij|^2 + 2 r_ij.(s_j - s_i) >= Gamma sigma_ij^2
+ *                                 for every pair closer than the cut-off,
+ *                                 |s_i,a| <= ell, s_0 = 0 (no translation).
+ *
+ * |r + ds|^2 = |r|^2 + 2 r.ds + |ds|^2 exceeds its linearisation, so a
+ * solution never overlaps: the configuration moves by s and then grows by
+ * the largest factor the real pairs allow (the box shrinks by 1/sqrt of
+ * it). The cut-off makes every pair left out unable to touch: with
+ * |s_i,a| <= ell a pair approaches by at most 2 ell sqrt(d), and Gamma is
+ * bounded by (1 + 2 ell/sigma_min)^2. The chain ends when sqrt(Gamma) - 1 <
+ * tol: the packing is then jammed to that precision (the programme's vertex
+ * is the isostatic network, its dual the contact forces), and the stepper's
+ * reset under compression takes the touching pairs as its network and
+ * finishes exactly as a compression run ends.
+ *
+ * The programmes are solved by COIN-OR CLP's dual simplex, each one warm
+ * started from the basis of the one before (pairs keep their status).
+ */
+#include <float.h>
+#include <limits.h>
+#include <stddef.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "stepper/stepper.h"
+#include "system/system.h"
+
+#if ODHS_HAVE_CLP
+#include <coin/Clp_C_Interface.h>
+#endif
+
+#define LP_TRUST 0.1        /* default bound on a displacement component, mean diameters */
+#define LP_TOL 1e-12        /* default: the chain ends at sqrt(Gamma) - 1 below this */
+#define LP_MAX 10000        /* default: programmes at most */
+#define LP_STEPS 100000     /* default: event-driven steps of the end game at most */
+#define LP_FEAS 1e-10       /* CLP's primal and dual feasibility tolerances */
+
+/* the fields of the options and the report the caller's size must cover */
+#define LP_OPT_MIN (offsetof(odhs_jam_lp_options, max_steps) + sizeof(size_t))
+#define LP_REP_MIN (offsetof(odhs_jam_lp_report, end_steps) + sizeof(uint64_t))
+
+static int lp_settings(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_jam_lp_options *o)
+{
+    memset(o, 0, sizeof *o);
+    if (opt) {
+        if (opt->size < LP_OPT_MIN)
+            return odhs__sterr(st, ODHS_E_INVALID,
+                               "odhs_jam_lp_options.size = %zu: set it to sizeof(odhs_jam_lp_options) (at least %zu)",
+                               opt->size, (size_t)LP_OPT_MIN);
+        memcpy(o, opt, opt->size < sizeof *o ? opt->size : sizeof *o);
+    }
+    if (!isfinite(o->trust) || !isfinite(o->tol))
+        return odhs__sterr(st, ODHS_E_NONFINITE, "jam_lp options: trust and tol must be finite");
+    if (o->trust < 0.0 || o->tol < 0.0)
+        return odhs__sterr(st, ODHS_E_INVALID, "jam_lp options: trust (%g) and tol (%g) must be >= 0 (0: default)",
+                           o->trust, o->tol);
+    if (o->trust > 0.5)
+        return odhs__sterr(st, ODHS_E_INVALID,
+                           "jam_lp options: trust %g is more than half a mean diameter per programme", o->trust);
+    if (o->trust == 0.0) o->trust = LP_TRUST;
+    if (o->tol == 0.0) o->tol = LP_TOL;
+    if (o->max_lps == 0) o->max_lps = LP_MAX;
+    if (o->max_steps == 0) o->max_steps = LP_STEPS;
+    return ODHS_OK;
+}
+
+/* what the fast route cannot do: it moves particles freely and grows them,
+ * so the driving must be a plain compression and the scene plain spheres */
+static int lp_check_scene(odhs_stepper *st)
+{
+    const odhs_driver *d = st->drv;
+    if (st->net->nwalls || st->net->nperm)
+        return odhs__sterr(st, ODHS_E_UNSUPPORTED,
+                           "jam_lp: the scene has walls or bonds (composites); the linear programmes know free "
+                           "particles only: use odhs_stepper_step");
+    if (!(d->crate > 0.0) || d->gdot != 0.0 || d->pressure_on || d->osc_shape || d->fn || d->F || d->prop_on ||
+        d->grav_on)
+        return odhs__sterr(st, ODHS_E_STATE,
+                           "jam_lp needs a driver with isotropic compression only (compression rate > 0; no shear, "
+                           "pressure, forces, callback, propulsion or gravity)");
+    return ODHS_OK;
+}
+
+#if ODHS_HAVE_CLP
+
+typedef struct {
+    size_t *i, *j;
+    double *rij; /* 3 per pair */
+    size_t m, cap_i, cap_j, cap_r;
+    int dim, nomem;
+} lp_pairs;
+
+static int lp_pair_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)gap;
+    lp_pairs *p = vctx;
+    if (odhs__reserve((void **)&p->i, &p->cap_i, p->m + 1, sizeof *p->i) ||
+        odhs__reserve((void **)&p->j, &p->cap_j, p->m + 1, sizeof *p->j) ||
+        odhs__reserve((void **)&p->rij, &p->cap_r, 3 * (p->m + 1), sizeof *p->rij)) {
+        p->nomem = 1;
+        return 1;
+    }
+    p->i[p->m] = i < j ? i : j;
+    p->j[p->m] = i < j ? j : i;
+    for (int a = 0; a < 3; ++a) p->rij[3 * p->m + a] = a < p->dim ? (i < j ? rij[a] : -rij[a]) : 0.0;
+    p->m++;
+    return 0;
+}
+
+/* a pair's status in the basis of the programme before (sorted by key) */
+typedef struct {
+    unsigned long long key;
+    unsigned char status;
+} lp_basis;
+
+static int lp_basis_cmp(const void *a, const void *b)
+{
+    unsigned long long x = ((const lp_basis *)a)->key, y = ((const lp_basis *)b)->key;
+    return x < y ? -1 : x > y;
+}
+
+/* the work of one chain (freed by lp_free) */
+typedef struct {
+    lp_pairs pr;
+    int *start, *row;
+    double *val, *rlo, *rup, *clo, *cup, *obj, *xc, *s;
+    double Lc[3]; /* the chain's configuration: positions xc, box Lc */
+    unsigned char *status;
+    lp_basis *basis;
+    size_t nbasis, cap_start, cap_row, cap_val, cap_rlo, cap_rup, cap_status, cap_basis;
+} lp_work;
+
+static void lp_free(lp_work *w)
+{
+    odhs__free(w->pr.i);
+    odhs__free(w->pr.j);
+    odhs__free(w->pr.rij);
+    odhs__free(w->start);
+    odhs__free(w->row);
+    odhs__free(w->val);
+    odhs__free(w->rlo);
+    odhs__free(w->rup);
+    odhs__free(w->clo);
+    odhs__free(w->cup);
+    odhs__free(w->obj);
+    odhs__free(w->xc);
+    odhs__free(w->s);
+    odhs__free(w->status);
+    odhs__free(w->basis);
+}
+
+/* One programme around the current configuration; *g receives the growth
+ * of the squared contact distances that the displacements w->s allow on
+ * the real (not linearised) pairs. */
+static int lp_solve(odhs_stepper *st, lp_work *w, double ell, odhs_jam_lp_report *rep, double *g)
+{
+    odhs_system *sys = st->sys;
+    const int d = st->dim;
+    const size_t n = st->n, nd = st->nd;
+    double smin = INFINITY, smax = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        smin = fmin(smin, 2.0 * sys->r[i]);
+        smax = fmax(smax, 2.0 * sys->r[i]);
+    }
+    const double groot = 1.0 + 2.0 * ell / smin; /* bound on sqrt(Gamma) */
+    const double cut = 2.0 * sqrt((double)d) * ell + (groot - 1.0) * smax;
+    w->pr.m = 0;
+    w->pr.dim = d;
+    w->pr.nomem = 0;
+    int s = odhs__pairs(d, n, w->xc, sys->r, sys->rmax, w->Lc, sys->gamma, cut, lp_pair_cb, &w->pr);
+    if (w->pr.nomem || s == ODHS_E_NOMEM) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+    if (s) return odhs__sterr(st, s, "jam_lp: pair search failed");
+    const size_t m = w->pr.m, nc = nd + 1;
+    if (m > (size_t)INT_MAX / 8 || nc > (size_t)INT_MAX / 8)
+        return odhs__sterr(st, ODHS_E_UNSUPPORTED, "jam_lp: %zu pairs are too many for the LP solver", m);
+    /* the constraint matrix by columns: coordinate a of particle k, then Gamma */
+    size_t nnz = m * (2 * (size_t)d + 1);
+    if (odhs__reserve((void **)&w->start, &w->cap_start, nc + 1, sizeof *w->start) ||
+        odhs__reserve((void **)&w->row, &w->cap_row, nnz, sizeof *w->row) ||
+        odhs__reserve((void **)&w->val, &w->cap_val, nnz, sizeof *w->val) ||
+        odhs__reserve((void **)&w->rlo, &w->cap_rlo, m + 1, sizeof *w->rlo) ||
+        odhs__reserve((void **)&w->rup, &w->cap_rup, m + 1, sizeof *w->rup) ||
+        odhs__reserve((void **)&w->status, &w->cap_status, nc + m, 1))
+        return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+    int *start = w->start;
+    memset(start, 0, (nc + 1) * sizeof *start);
+    for (size_t q = 0; q < m; ++q) {
+        for (int a = 0; a < d; ++a) {
+            start[w->pr.i[q] * (size_t)d + (size_t)a + 1]++;
+            start[w->pr.j[q] * (size_t)d + (size_t)a + 1]++;
+        }
+        start[nc]++;
+    }
+    for (size_t c = 0; c < nc; ++c) start[c + 1] += start[c];
+    for (size_t q = 0; q < m; ++q) {
+        size_t i = w->pr.i[q], j = w->pr.j[q];
+        const double *v = w->pr.rij + 3 * q;
+        double sig2 = (sys->r[i] + sys->r[j]) * (sys->r[i] + sys->r[j]), r2 = 0.0;
+        for (int a = 0; a < d; ++a) {
+            r2 += v[a] * v[a];
+            size_t ci = i * (size_t)d + (size_t)a, cj = j * (size_t)d + (size_t)a;
+            w->row[start[ci]] = (int)q;
+            w->val[start[ci]++] = -2.0 * v[a] / sig2;
+            w->row[start[cj]] = (int)q;
+            w->val[start[cj]++] = 2.0 * v[a] / sig2;
+        }
+        w->row[start[nc - 1]] = (int)q;
+        w->val[start[nc - 1]++] = -1.0;
+        w->rlo[q] = -r2 / sig2;
+        w->rup[q] = DBL_MAX;
+    }
+    for (size_t c = nc; c-- > 0;) start[c + 1] = start[c]; /* the fill moved each start one column on */
+    start[0] = 0;
+    for (size_t c = 0; c < nd; ++c) {
+        w->clo[c] = c < (size_t)d ? 0.0 : -ell;
+        w->cup[c] = c < (size_t)d ? 0.0 : ell;
+        w->obj[c] = 0.0;
+    }
+    w->clo[nd] = 0.0;
+    w->cup[nd] = groot * groot;
+    w->obj[nd] = 1.0;
+
+    Clp_Simplex *M = Clp_newModel();
+    if (!M) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory (LP solver)");
+    Clp_setLogLevel(M, 0);
+    Clp_loadProblem(M, (int)nc, (int)m, start, w->row, w->val, w->clo, w->cup, w->obj, w->rlo, w->rup);
+    Clp_setObjSense(M, -1.0);
+    Clp_setPrimalTolerance(M, LP_FEAS);
+    Clp_setDualTolerance(M, LP_FEAS);
+    if (w->nbasis) { /* warm start: columns as before, pairs as before (new ones basic) */
+        for (size_t q = 0; q < m; ++q) {
+            lp_basis key = {(unsigned long long)w->pr.i[q] * n + w->pr.j[q], 1};
+            const lp_basis *f = bsearch(&key, w->basis, w->nbasis, sizeof *w->basis, lp_basis_cmp);
+            w->status[nc + q] = f ? f->status : 1;
+        }
+        Clp_copyinStatus(M, w->status);
+    }
+    Clp_dual(M, 0);
+    int lps = Clp_status(M);
+    rep->simplex_iterations += (uint64_t)Clp_numberIterations(M);
+    if (lps != 0) {
+        Clp_deleteModel(M);
+        return odhs__sterr(st, ODHS_E_NOCONV, "jam_lp: the LP solver stopped with status %d (%s)", lps,
+                           lps == 1   ? "primal infeasible"
+                           : lps == 2 ? "dual infeasible"
+                           : lps == 3 ? "iteration limit"
+                                      : "numerical difficulties");
+    }
+    const double *cs = Clp_getColSolution(M);
+    memcpy(w->s, cs, nd * sizeof *w->s);
+    memcpy(w->status, Clp_statusArray(M), nc + m);
+    Clp_deleteModel(M);
+    /* the basis of this programme, for the next one */
+    if (odhs__reserve((void **)&w->basis, &w->cap_basis, m + 1, sizeof *w->basis))
+        return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+    for (size_t q = 0; q < m; ++q) {
+        w->basis[q].key = (unsigned long long)w->pr.i[q] * n + w->pr.j[q];
+        w->basis[q].status = w->status[nc + q];
+    }
+    w->nbasis = m;
+    qsort(w->basis, m, sizeof *w->basis, lp_basis_cmp);
+    if (m > rep->rows_max) rep->rows_max = m;
+    /* the growth the real pairs allow */
+    double gr = groot * groot;
+    for (size_t q = 0; q < m; ++q) {
+        size_t i = w->pr.i[q], j = w->pr.j[q];
+        const double *v = w->pr.rij + 3 * q;
+        double sig = sys->r[i] + sys->r[j], r2 = 0.0;
+        for (int a = 0; a < d; ++a) {
+            double e = v[a] + w->s[j * (size_t)d + (size_t)a] - w->s[i * (size_t)d + (size_t)a];
+            r2 += e * e;
+        }
+        gr = fmin(gr, r2 / (sig * sig));
+    }
+    *g = gr;
+    return ODHS_OK;
+}
+
+/* move by w->s and grow by g (the box shrinks by 1/sqrt(g)) */
+static void lp_apply(odhs_stepper *st, lp_work *w, double g)
+{
+    const int d = st->dim;
+    const double f = 1.0 / sqrt(g);
+    for (size_t k = 0; k < st->nd; ++k) w->xc[k] += w->s[k];
+    for (size_t i = 0; i < st->n; ++i) odhs__wrap(d, w->Lc, st->sys->gamma, w->xc + i * (size_t)d);
+    for (size_t k = 0; k < st->nd; ++k) w->xc[k] *= f;
+    for (int a = 0; a < d; ++a) w->Lc[a] *= f;
+    for (size_t i = 0; i < st->n; ++i) odhs__wrap(d, w->Lc, st->sys->gamma, w->xc + i * (size_t)d);
+}
+
+/* The chain on private copies of the configuration (w->xc, w->Lc): the
+ * stepper and its system are not touched. */
+static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, odhs_jam_lp_report *rep)
+{
+    const odhs_system *sys = st->sys;
+    const int d = st->dim;
+    const size_t nc = st->nd + 1;
+    if (!(w->clo = odhs__malloc_array(nc, sizeof *w->clo)) || !(w->cup = odhs__malloc_array(nc, sizeof *w->cup)) ||
+        !(w->obj = odhs__malloc_array(nc, sizeof *w->obj)) || !(w->xc = odhs__malloc_array(st->nd, sizeof *w->xc)) ||
+        !(w->s = odhs__malloc_array(st->nd, sizeof *w->s)))
+        return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+    memcpy(w->xc, sys->x, st->nd * sizeof *w->xc);
+    memcpy(w->Lc, sys->L, sizeof w->Lc);
+    /* the trust region, and a cut-off the cell search allows (half the
+     * shortest box edge minus the largest diameter) */
+    double smin = INFINITY, smax = 0.0, lam = 0.0;
+    for (size_t i = 0; i < st->n; ++i) {
+        smin = fmin(smin, 2.0 * sys->r[i]);
+        smax = fmax(smax, 2.0 * sys->r[i]);
+        lam += 2.0 * sys->r[i] / (double)st->n;
+    }
+    const double ell = o->trust * lam, per_ell = 2.0 * sqrt((double)d) + 2.0 * smax / smin;
+    int s;
+    for (size_t k = 0; k < o->max_lps; ++k) {
+        double lmin = fmin(w->Lc[0], w->Lc[1]);
+        if (d == 3) lmin = fmin(lmin, w->Lc[2]);
+        double e = fmin(ell, 0.9 * (0.5 * lmin - 2.0 * sys->rmax) / per_ell);
+        if (!(e > 1e-6 * lam))
+            return odhs__sterr(st, ODHS_E_BOX, "jam_lp: the box (shortest edge %g) is too small for the programmes",
+                               lmin);
+        double g = 1.0;
+        if ((s = lp_solve(st, w, e, rep, &g))) return s;
+        rep->n_lps++;
+        rep->growth_last = sqrt(g) - 1.0;
+        if (g > 1.0) lp_apply(st, w, g);
+        if (!(sqrt(g) - 1.0 >= o->tol)) break;
+    }
+    return ODHS_OK;
+}
+
+#endif /* ODHS_HAVE_CLP */
+
+int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_jam_lp_report *rep)
+{
+    if (!st) return ODHS_E_NULL;
+    st->errmsg[0] = '\0'; /* a successful call leaves no message */
+    int s;
+    if (rep && rep->size < LP_REP_MIN)
+        return odhs__sterr(st, ODHS_E_INVALID,
+                           "odhs_jam_lp_report.size = %zu: set it to sizeof(odhs_jam_lp_report) (at least %zu)",
+                           rep->size, (size_t)LP_REP_MIN);
+    odhs_jam_lp_options o;
+    if ((s = lp_settings(st, opt, &o))) return s;
+    if ((s = odhs__st_check_handles(st))) return s;
+    if ((s = lp_check_scene(st))) return s;
+    if (!st->ready && (s = odhs_stepper_reset(st))) return s;
+    if (st->jammed) return odhs__sterr(st, ODHS_JAMMED, "the packing is jammed: nothing to compress");
+#if ODHS_HAVE_CLP
+    odhs_jam_lp_report r;
+    memset(&r, 0, sizeof r);
+    odhs_system *sys = st->sys;
+    lp_work w;
+    memset(&w, 0, sizeof w);
+    double *x0 = odhs__malloc_array(st->nd, sizeof *x0);
+    if (!x0) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+    if ((s = lp_chain(st, &o, &w, &r))) goto done;
+    /* commit: the stepper moves its system (as a step does) and is reset on
+     * the packing; a failed reset puts both back */
+    double L0[3];
+    memcpy(x0, sys->x, st->nd * sizeof *x0);
+    memcpy(L0, sys->L, sizeof L0);
+    memcpy(sys->x, w.xc, st->nd * sizeof *w.xc);
+    memcpy(sys->L, w.Lc, sizeof w.Lc);
+    const int pre0 = st->pre_state;
+    if ((s = odhs_stepper_reset(st))) {
+        char msg[ODHS_ERRMSG_LEN];
+        memcpy(msg, st->errmsg, sizeof msg);
+        memcpy(sys->x, x0, st->nd * sizeof *x0);
+        memcpy(sys->L, L0, sizeof L0);
+        odhs__net_geometry(st->net, sys); /* the gaps and normals of the start */
+        st->ready = 1;
+        st->jammed = 0;
+        st->pre_state = pre0;
+        memcpy(st->errmsg, msg, sizeof msg);
+        goto done;
+    }
+    odhs_system_packing_fraction(sys, &r.phi_lp);
+    /* the end game: normally jammed at the reset */
+    while (!st->jammed && r.end_steps < o.max_steps) {
+        s = odhs_stepper_step(st, NULL);
+        if (s == ODHS_OK || s == ODHS_STOPPED || s == ODHS_JAMMED) r.end_steps++;
+        if (s != ODHS_OK && s != ODHS_STOPPED) break;
+    }
+    if (st->jammed) {
+        s = odhs__sterr(st, ODHS_JAMMED, "jammed by %zu linear programmes and %llu event-driven steps at phi = %.15g",
+                        r.n_lps, (unsigned long long)r.end_steps, r.phi_lp);
+    } else if (s == ODHS_OK || s == ODHS_STOPPED) {
+        s = odhs__sterr(st, ODHS_E_STALLED,
+                        "jam_lp: not jammed after %zu event-driven steps of the end game (phi = %.15g after %zu "
+                        "programmes)",
+                        o.max_steps, r.phi_lp, r.n_lps);
+    }
+    if (rep) {
+        size_t size = rep->size;
+        r.size = size;
+        memcpy(rep, &r, size < sizeof r ? size : sizeof r);
+    }
+done:
+    lp_free(&w);
+    odhs__free(x0);
+    return s;
+#else
+    (void)o;
+    return odhs__sterr(st, ODHS_E_NOTINSTALLED,
+                       "jam_lp: this libodhs was built without an LP solver (COIN-OR CLP: Debian coinor-libclp-dev)");
+#endif
+}
