@@ -177,7 +177,10 @@ static void run_soft(result *r)
  * affinely to phi = 0.70 (2D; 0.50 in 3D), FIRE to |F| < 1e-14 (LAMMPS's ftol: the 2-norm of
  * the global force vector), then steps of dphi = 1e-3 halved from the last
  * unjammed state whenever the largest pair force after the minimisation
- * exceeds 1e-10 (jammed), until dphi < 1e-6 phi. Prints "phi_unjammed
+ * exceeds 1e-10 (jammed; a minimisation that stops at its 1e5 iterations
+ * has not relaxed its overlaps, so it counts as jammed, as in run_soft),
+ * until dphi < 1e-6 phi. FIRE's time step 0.2 (masses pi/6 rho d^3 with
+ * rho = 1, k_n = 1). Prints "phi_unjammed
  * phi_jammed minimisations" to the file ${out}. */
 static const char lammps_input[] =
     "units lj\n"
@@ -192,7 +195,7 @@ static const char lammps_input[] =
     "pair_coeff * * hooke 1.0 0.0 tangential linear_nohistory 0.0 0.0\n"
     "neighbor 0.3 bin\n"
     "neigh_modify delay 0 every 1 check yes\n"
-    "timestep 0.05\n"
+    "timestep 0.2\n"
     "compute rad all property/atom radius\n"
     "variable va atom ${vfac}*c_rad^${dim}\n"
     "compute sa all reduce sum v_va\n"
@@ -205,7 +208,7 @@ static const char lammps_input[] =
     "run 0 post no\n"
     "variable s0 equal $((v_phi/v_phi0)^(1.0/v_dim))\n"
     "change_box all @S0@ remap\n"
-    "minimize 0.0 1e-14 1000000 10000000\n"
+    "minimize 0.0 1e-14 100000 1000000\n"
     "run 0 post no\n"
     "variable phiu equal $(v_phi)\n"
     "variable phih equal 1.0\n"
@@ -216,7 +219,7 @@ static const char lammps_input[] =
     "label loop\n"
     "variable s equal $((v_phiu/(v_phiu+v_dphi))^(1.0/v_dim))\n"
     "change_box all @S@ remap\n"
-    "minimize 0.0 1e-14 1000000 10000000\n"
+    "minimize 0.0 1e-14 100000 1000000\n"
     "run 0 post no\n"
     "variable nmin equal $(v_nmin+1)\n"
     "if \"$(c_fm) > 1e-10\" then \"variable phih equal $(v_phi)\" "

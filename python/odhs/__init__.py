@@ -34,8 +34,8 @@ from .errors import (BoxError, CallbackError, DimensionError, EmptyError, Error,
 from .io import (Trajectory, count_xyz_frames, parse_lammps_data, parse_xyz, read_lammps_data, read_xyz,
                  traj_format_for, write_contacts, write_contacts_csv, write_lammps_data, write_svg, write_xyz)
 from .network import Network
-from .records import (AdaptiveStats, Certificate, Constrained, Contacts, Counts, Errors, Event, OscillatoryShear,
-                      Propulsion, RunLimits, Settings, SoftcoreCounts, SolverInfo, StepInfo)
+from .records import (AdaptiveStats, Certificate, Constrained, Contacts, Counts, Errors, Event, JamLpReport,
+                      OscillatoryShear, Propulsion, RunLimits, Settings, SoftcoreCounts, SolverInfo, StepInfo)
 from .softcore import Softcore
 from .solver import Solver, SolverBackend, available_solvers
 from .stepper import Stepper, parse_checkpoint, read_checkpoint
@@ -95,6 +95,6 @@ __all__ = [
     "EventKind", "ContactKind", "Integrator", "Oscillation", "Feature", "WallShape", "TrajFormat",
     "SoftcoreModel", "SoftcoreIntegrator", "Minimiser", "StressPart", "SolverFlag",
     "Event", "StepInfo", "Counts", "Settings", "RunLimits", "AdaptiveStats", "Errors", "Contacts", "Constrained",
-    "Certificate", "Propulsion", "OscillatoryShear", "SoftcoreCounts", "SolverInfo", "Separation", "Pairs",
+    "Certificate", "JamLpReport", "Propulsion", "OscillatoryShear", "SoftcoreCounts", "SolverInfo", "Separation", "Pairs",
     "version", "version_number", "header_version", "library_path",
 ]

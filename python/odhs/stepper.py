@@ -17,7 +17,8 @@ from .constants import EventKind, Feature, Integrator, to_enum
 from .driver import Driver
 from .errors import last_error, make_error
 from .network import Network
-from .records import (AdaptiveStats, Certificate, Contacts, Counts, Errors, Event, RunLimits, Settings, StepInfo)
+from .records import (AdaptiveStats, Certificate, Contacts, Counts, Errors, Event, JamLpReport, RunLimits, Settings,
+                      StepInfo)
 from .solver import Solver
 from .system import System
 
@@ -618,6 +619,25 @@ class Stepper(Owned):
                            int(c.n_rattlers), int(c.n_backbone), int(c.n_contacts), int(c.n_contacts_backbone),
                            int(c.n_contacts_isostatic), c.z, c.z_backbone, c.force_balance, c.gap_error, c.overlap,
                            c.min_force, int(c.n_pivots))
+
+    def jam_lp(self, trust=0.0, tol=0.0, max_lps=0, max_steps=0):
+        """The fast route to a certified jammed packing (odhs_stepper_jam_lp, since 0.2.9): a
+        chain of linear programmes compresses the system to jamming, then the stepper's exact
+        end game certifies it. The driver must compress and do nothing else. Options left 0
+        take the library's defaults (trust region 0.1 mean diameters, tol 1e-12). Returns
+        (status, JamLpReport); status is Status.JAMMED when the packing is made."""
+        o = ffi.new("odhs_jam_lp_options *")
+        o.size = ffi.sizeof("odhs_jam_lp_options")
+        o.trust = float(trust)
+        o.tol = float(tol)
+        o.max_lps = int(max_lps)
+        o.max_steps = int(max_steps)
+        r = ffi.new("odhs_jam_lp_report *")
+        r.size = ffi.sizeof("odhs_jam_lp_report")
+        rc = lib.odhs_stepper_jam_lp(self._p or self._closed(), o, r)
+        st = self._run_result(rc, "Stepper.jam_lp")
+        return st, JamLpReport(int(r.n_lps), int(r.simplex_iterations), int(r.rows_max), r.phi_lp, r.growth_last,
+                               int(r.end_steps))
 
     # --- files -------------------------------------------------------------------------------
     def write_checkpoint(self, path):

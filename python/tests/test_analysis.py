@@ -116,3 +116,26 @@ def test_event_split_and_pre_event_stress():
     b, a, c, o = (np.array(x) for x in zip(*rows))
     jumps, _ = analysis.event_split(b, a, (c > 0) & (o == 0))
     assert jumps.size > 5 and jumps.min() > -1e-9 * a.max()
+
+
+def test_jam_lp_certified():
+    # the fast route (odhs_stepper_jam_lp): certified, as jam_packing --method lp
+    s = odhs.System(2, 64)
+    s.set_radii_bidisperse(0.5, 1.4, 0.03, 7)
+    s.place_random(0.45, 8)
+    d = odhs.Driver(shear_rate=1.0)
+    st = odhs.Stepper(s, d, odhs.Solver("dense"))
+    with pytest.raises(odhs.StateError):
+        st.jam_lp()
+    d.shear_rate = 0.0
+    d.compression_rate = 1.0
+    with pytest.raises(odhs.InvalidError):
+        st.jam_lp(trust=0.9)
+    try:
+        status, rep = st.jam_lp()
+    except odhs.NotInstalledError:
+        pytest.skip("libodhs built without CLP")
+    assert status == odhs.Status.JAMMED
+    c = st.certificate()
+    assert c.jammed and c.isostatic and c.force_balance < 1e-12 and c.gap_error < 1e-13 and c.overlap <= 1e-14
+    assert c.min_force > 0 and rep.n_lps >= 3 and abs(rep.phi_lp - c.phi) < 1e-9 and rep.growth_last < 1e-12
