@@ -44,6 +44,15 @@
  *     time, phi_J bracket, overlaps at jamming, against the event-driven
  *     packing (exact contacts, certified). ODHS_BENCH_SOFT_LIMIT (seconds,
  *     default 3600) bounds each of these runs.
+ *  4. (not in the default "123") the routes side by side from the same
+ *     starts, seeds 1..ODHS_BENCH_ROUTE_SEEDS (default 5), sizes
+ *     ODHS_BENCH_ROUTE_SIZES (default 2:256,2:1024,3:343,3:1000), routes
+ *     ODHS_BENCH_ROUTES (default lp,events,soft,lammps): the fast route
+ *     (odhs_stepper_jam_lp), the event-driven compression, the soft-sphere
+ *     route of table 3, and LAMMPS (lmp, Debian package lammps) running the
+ *     O'Hern protocol from an input this program writes; a route missing
+ *     from the machine is reported as skipped. CPU seconds per packing and
+ *     their ratio to the fast route. ODHS_BENCH_SOFT_LIMIT bounds each run.
  *
  * Every packing runs in a child process (fork), so a run that exceeds its
  * time limit is killed and reported instead of stalling the benchmark.

@@ -1110,6 +1110,31 @@ START_TEST(test_lp_lees_edwards)
 }
 END_TEST
 
+/* jam_packing --protocol shear --method lp: the fast route jams, the packing
+ * is dilated by 0.2% and sheared at fixed volume until it arrests; the shear
+ * jammed packing is certified as any other (seeds 1 and 3 arrest within a
+ * strain of 0.1) */
+START_TEST(test_lp_then_shear)
+{
+    static const uint64_t seeds[2] = {1, 3};
+    jrun r;
+    jrun_start(&r, 2, 64, seeds[_i], "compress", "default");
+    jrun_configure(&r);
+    ck_assert_int_eq(odhs_stepper_jam_lp(r.st, NULL, NULL), ODHS_JAMMED);
+    CHECK_OK(odhs_system_scale_box(r.sys, sqrt(1.002)));
+    CHECK_OK(odhs_driver_set_compression_rate(r.drv, 0.0));
+    CHECK_OK(odhs_driver_set_shear_rate(r.drv, 1.0));
+    CHECK_OK(odhs_stepper_reset(r.st));
+    r.rc = ODHS_OK;
+    for (double g = 0.05; g < 2.0 && r.rc == ODHS_OK; g += 0.05) r.rc = odhs_stepper_run_until_strain(r.st, g);
+    char msg[768] = "";
+    int ok = r.rc == ODHS_JAMMED && independent_check(&r, msg, sizeof msg);
+    int rc = r.rc;
+    jrun_free(&r);
+    ck_assert_msg(ok, "status %d: %s", rc, msg);
+}
+END_TEST
+
 /* The report; a run cut short (one programme, one step of the end game)
  * returns ODHS_E_STALLED at the state it reached, from which a second call
  * jams */
@@ -2439,6 +2464,7 @@ Suite *make_jamming_suite(void)
     tcase_add_loop_test(tc, test_lp_certified, 0, (int)(sizeof lp_cases / sizeof lp_cases[0]));
     tcase_add_test(tc, test_lp_phi_statistics);
     tcase_add_test(tc, test_lp_lees_edwards);
+    tcase_add_loop_test(tc, test_lp_then_shear, 0, 2);
     tcase_add_test(tc, test_lp_report_and_stall);
 #endif
     suite_add_tcase(s, tc);
