@@ -579,6 +579,35 @@ static double estimate(double t0, size_t n0, size_t n, int dense)
     return t0 * pow((double)n / (double)n0, EXPONENT(dense));
 }
 
+/* dim:N pairs separated by commas from environment variable `name` into
+ * sizes (at most 8); *ns keeps its value when the variable is unset or
+ * empty. Returns 1 after a message on a malformed entry. */
+typedef struct {
+    int dim;
+    size_t n;
+} size_spec;
+
+static int parse_sizes(const char *name, size_spec *sizes, int *ns)
+{
+    const char *env = getenv(name);
+    if (!env || !*env) return 0;
+    *ns = 0;
+    for (const char *q = env; *q && *ns < 8;) {
+        int dd = 0, used = 0;
+        unsigned long nn = 0;
+        if (sscanf(q, "%d:%lu%n", &dd, &nn, &used) != 2 || (dd != 2 && dd != 3) || nn < 2) {
+            fprintf(stderr, "jamming: bad %s entry at \"%s\" (want dim:N,...)\n", name, q);
+            return 1;
+        }
+        sizes[*ns].dim = dd;
+        sizes[*ns].n = (size_t)nn;
+        (*ns)++;
+        q += used;
+        if (*q == ',') q++;
+    }
+    return 0;
+}
+
 /* ---- table 4: the routes side by side (issue 22) ------------------------------------ */
 /* ODHS_BENCH_ROUTE_SIZES (dim:N,...; default 2:256,2:1024,3:343,3:1000),
  * ODHS_BENCH_ROUTE_SEEDS (seeds 1..S, default 5) and ODHS_BENCH_ROUTES (a
@@ -590,28 +619,9 @@ static const char *const route_names[R_N] = {"lp", "events", "soft", "lammps"};
 
 static int table4(int workers, double limit)
 {
-    struct {
-        int dim;
-        size_t n;
-    } sizes[8] = {{2, 256}, {2, 1024}, {3, 343}, {3, 1000}};
+    size_spec sizes[8] = {{2, 256}, {2, 1024}, {3, 343}, {3, 1000}};
     int ns = 4;
-    const char *env = getenv("ODHS_BENCH_ROUTE_SIZES");
-    if (env && *env) {
-        ns = 0;
-        for (const char *q = env; *q && ns < 8;) {
-            int dd = 0, used = 0;
-            unsigned long nn = 0;
-            if (sscanf(q, "%d:%lu%n", &dd, &nn, &used) != 2 || (dd != 2 && dd != 3) || nn < 2) {
-                fprintf(stderr, "jamming: bad ODHS_BENCH_ROUTE_SIZES entry at \"%s\" (want dim:N,...)\n", q);
-                return 1;
-            }
-            sizes[ns].dim = dd;
-            sizes[ns].n = (size_t)nn;
-            ns++;
-            q += used;
-            if (*q == ',') q++;
-        }
-    }
+    if (parse_sizes("ODHS_BENCH_ROUTE_SIZES", sizes, &ns)) return 1;
     const char *se = getenv("ODHS_BENCH_ROUTE_SEEDS");
     int seeds = se && atoi(se) > 0 ? atoi(se) : 5;
     if (seeds > 50) seeds = 50;
@@ -942,29 +952,9 @@ int main(int argc, char **argv)
     if (do2) csv_runs("timing", tr, NT);
 
     /* ---- table 3: the soft-sphere route on the same starts ------------------------ */
-    struct {
-        int dim;
-        size_t n;
-    } soft_sizes[8] = {{2, 256}, {2, 1024}, {3, 128}};
+    size_spec soft_sizes[8] = {{2, 256}, {2, 1024}, {3, 128}};
     int NS = do3 ? 3 : 0;
-    const char *ss_env = getenv("ODHS_BENCH_SOFT_SIZES");
-    if (do3 && ss_env && *ss_env) {
-        NS = 0;
-        for (const char *q = ss_env; *q && NS < 8;) {
-            int dd = 0;
-            unsigned long nn = 0;
-            int used = 0;
-            if (sscanf(q, "%d:%lu%n", &dd, &nn, &used) != 2 || (dd != 2 && dd != 3) || nn < 2) {
-                fprintf(stderr, "jamming: bad ODHS_BENCH_SOFT_SIZES entry at \"%s\" (want dim:N,...)\n", q);
-                return 2;
-            }
-            soft_sizes[NS].dim = dd;
-            soft_sizes[NS].n = (size_t)nn;
-            NS++;
-            q += used;
-            if (*q == ',') q++;
-        }
-    }
+    if (do3 && parse_sizes("ODHS_BENCH_SOFT_SIZES", soft_sizes, &NS)) return 2;
     result sr[8], er[8];
     memset(sr, 0, sizeof sr);
     memset(er, 0, sizeof er);
