@@ -50,7 +50,7 @@ static point *find_point(size_t n, double phi)
 }
 
 /* mean and block-averaged error of the shear stress after the transient */
-static int run_stats(const char *path, double transient, double *mean, double *sem)
+static int run_stats(const char *path, double transient, double *mean, double *sem, double *last)
 {
     FILE *f = fopen(path, "r");
     if (!f) return -1;
@@ -75,6 +75,7 @@ static int run_stats(const char *path, double transient, double *mean, double *s
             if (c == col_g) g = atof(t);
             if (c == col_s) s = atof(t);
         }
+        if (isfinite(g)) *last = g;
         if (!(g > transient) || !isfinite(s)) continue;
         if (m == cap) x = realloc(x, (cap *= 2) * sizeof *x);
         x[m++] = s;
@@ -95,7 +96,7 @@ static int read_dir(const char *dir, double transient)
     snprintf(path, sizeof path, "%s/campaign.txt", dir);
     FILE *f = fopen(path, "r");
     if (!f) return -1;
-    int in = 0, header = 0, run = 0, cn = -1, cphi = -1;
+    int in = 0, header = 0, run = 0, cn = -1, cphi = -1, cstrain = -1;
     while (fgets(line, sizeof line, f)) {
         if (!in) {
             in = !strncmp(line, "--- campaign ---", 16);
@@ -107,23 +108,30 @@ static int read_dir(const char *dir, double transient)
             for (char *t = strtok(line, ",\n"); t; t = strtok(NULL, ",\n"), ++c) {
                 if (!strcmp(t, "n")) cn = c;
                 if (!strcmp(t, "phi")) cphi = c;
+                if (!strcmp(t, "strain")) cstrain = c;
             }
             header = 1;
             continue;
         }
         /* empty fields: parse by hand */
         size_t n = 0;
-        double phi = NAN;
+        double phi = NAN, strain = 0.0;
         int c = 0;
         for (char *p = line, *q; p; p = q ? q + 1 : NULL, ++c) {
             q = strchr(p, ',');
             if (c == cn) n = (size_t)atol(p);
             if (c == cphi) phi = atof(p);
+            if (c == cstrain) strain = atof(p);
         }
-        double mean, sem;
+        double mean, sem, last = 0.0;
         snprintf(path, sizeof path, "%s/runs/run_%04d/series.csv", dir, run++);
-        if (run_stats(path, transient, &mean, &sem)) {
+        if (run_stats(path, transient, &mean, &sem, &last)) {
             fprintf(stderr, "validation_viscosity: %s: no usable series (run not finished?)\n", path);
+            continue;
+        }
+        if (last < strain - 1e-6) { /* a run still going (or stopped): only finished runs count */
+            fprintf(stderr, "validation_viscosity: %s: at strain %g of %g, not finished: left out\n", path, last,
+                    strain);
             continue;
         }
         point *p = find_point(n, phi);
