@@ -1110,6 +1110,26 @@ START_TEST(test_lp_lees_edwards)
 }
 END_TEST
 
+/* A degenerate packing (a backbone contact of zero force) is shaken and
+ * jammed again: with the threshold raised past every force, each packing
+ * counts as degenerate, so the call shakes 3 times and returns the last
+ * packing, certified */
+START_TEST(test_lp_shake)
+{
+    jrun r;
+    jrun_start(&r, 2, 64, 3, "compress", "default");
+    jrun_configure(&r);
+    odhs__stepper_set_lp_min_force(r.st, 1e300);
+    odhs_jam_lp_report rep = {.size = sizeof rep};
+    r.rc = odhs_stepper_jam_lp(r.st, NULL, &rep);
+    char msg[768] = "";
+    int ok = r.rc == ODHS_JAMMED && independent_check(&r, msg, sizeof msg);
+    int rc = r.rc;
+    jrun_free(&r);
+    ck_assert_msg(ok && rep.shakes == 3 && rep.growth_last < 1e-12, "status %d, %zu shakes: %s", rc, rep.shakes, msg);
+}
+END_TEST
+
 /* jam_packing --protocol shear --method lp: the fast route jams, the packing
  * is dilated by 0.2% and sheared at fixed volume until it arrests; the shear
  * jammed packing is certified as any other (seeds 1 and 3 arrest within a
@@ -2465,6 +2485,7 @@ Suite *make_jamming_suite(void)
     tcase_add_test(tc, test_lp_phi_statistics);
     tcase_add_test(tc, test_lp_lees_edwards);
     tcase_add_loop_test(tc, test_lp_then_shear, 0, 2);
+    tcase_add_test(tc, test_lp_shake);
     tcase_add_test(tc, test_lp_report_and_stall);
 #endif
     suite_add_tcase(s, tc);

@@ -99,6 +99,7 @@ typedef struct odhs_jam_lp_report {
     double phi_lp;               /* packing fraction at the end of the chain      */
     double growth_last;          /* sqrt(Gamma) - 1 of the last programme         */
     uint64_t end_steps;          /* event-driven steps of the end game (usually 0) */
+    size_t shakes;               /* degenerate packings shaken and jammed again    */
 } odhs_jam_lp_report;
 
 /**
@@ -121,6 +122,12 @@ typedef struct odhs_jam_lp_report {
  * tolerance) as its network, and steps under the compression until
  * ODHS_JAMMED (normally at once), with the rewiring, self-stress, polish and
  * final pivots of a compression run.
+ *
+ * A packing whose smallest backbone force is below 1e-9 of the mean (a
+ * degenerate vertex of the last programme: a contact that carries no force
+ * and can still open) is not returned: the configuration is dilated by
+ * 1e-5, each coordinate moved by a deterministic noise of 1e-7 mean
+ * diameters, and the chain runs again (at most 3 times; report.shakes).
  *
  * A different protocol from the event-driven compression: the programmes
  * move particles by up to `trust` at a time, not along the overdamped

@@ -46,6 +46,8 @@
 #define LP_MAX 10000        /* default: programmes at most */
 #define LP_STEPS 100000     /* default: event-driven steps of the end game at most */
 #define LP_FEAS 1e-10       /* CLP's primal and dual feasibility tolerances */
+#define LP_SHAKES 3         /* shakes of a degenerate packing at most */
+#define LP_MIN_FORCE 1e-9   /* a backbone force below this (relative to the mean) is degenerate */
 
 /* the fields of the options and the report the caller's size must cover */
 #define LP_OPT_MIN (offsetof(odhs_jam_lp_options, max_steps) + sizeof(size_t))
@@ -300,19 +302,45 @@ static void lp_apply(odhs_stepper *st, lp_work *w, double g)
     for (size_t i = 0; i < st->n; ++i) odhs__wrap(d, w->Lc, st->sys->gamma, w->xc + i * (size_t)d);
 }
 
+/* splitmix64: the shake's deterministic noise (no global state) */
+static uint64_t lp_mix(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
 /* The chain on private copies of the configuration (w->xc, w->Lc): the
- * stepper and its system are not touched. */
-static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, odhs_jam_lp_report *rep)
+ * stepper and its system are not touched. shake > 0: the start is first
+ * dilated by LP_SHAKE_DILATE and every coordinate moved by a deterministic
+ * noise of LP_SHAKE_NOISE mean diameters (round shake), far less than the
+ * gaps the dilation opens, so no pair overlaps. */
+#define LP_SHAKE_DILATE 1e-5
+#define LP_SHAKE_NOISE 1e-7
+static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, odhs_jam_lp_report *rep, int shake)
 {
     const odhs_system *sys = st->sys;
     const int d = st->dim;
     const size_t nc = st->nd + 1;
-    if (!(w->clo = odhs__malloc_array(nc, sizeof *w->clo)) || !(w->cup = odhs__malloc_array(nc, sizeof *w->cup)) ||
-        !(w->obj = odhs__malloc_array(nc, sizeof *w->obj)) || !(w->xc = odhs__malloc_array(st->nd, sizeof *w->xc)) ||
-        !(w->s = odhs__malloc_array(st->nd, sizeof *w->s)))
+    if (!w->s &&
+        (!(w->clo = odhs__malloc_array(nc, sizeof *w->clo)) || !(w->cup = odhs__malloc_array(nc, sizeof *w->cup)) ||
+         !(w->obj = odhs__malloc_array(nc, sizeof *w->obj)) || !(w->xc = odhs__malloc_array(st->nd, sizeof *w->xc)) ||
+         !(w->s = odhs__malloc_array(st->nd, sizeof *w->s))))
         return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     memcpy(w->xc, sys->x, st->nd * sizeof *w->xc);
     memcpy(w->Lc, sys->L, sizeof w->Lc);
+    w->nbasis = 0; /* a new start: no basis to warm-start from */
+    if (shake) {
+        double lam0 = 0.0;
+        for (size_t i = 0; i < st->n; ++i) lam0 += 2.0 * sys->r[i] / (double)st->n;
+        for (int a = 0; a < d; ++a) w->Lc[a] *= 1.0 + LP_SHAKE_DILATE;
+        for (size_t k = 0; k < st->nd; ++k) {
+            double u = (double)(lp_mix((uint64_t)k * 4u + (uint64_t)shake) >> 11) * 0x1.0p-53;
+            w->xc[k] = w->xc[k] * (1.0 + LP_SHAKE_DILATE) + LP_SHAKE_NOISE * lam0 * (2.0 * u - 1.0);
+        }
+        for (size_t i = 0; i < st->n; ++i) odhs__wrap(d, w->Lc, sys->gamma, w->xc + i * (size_t)d);
+    }
     /* the trust region, and a cut-off the cell search allows (half the
      * shortest box edge minus the largest diameter) */
     double smin = INFINITY, smax = 0.0, lam = 0.0;
@@ -342,6 +370,11 @@ static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, 
 
 #endif /* ODHS_HAVE_CLP */
 
+void odhs__stepper_set_lp_min_force(odhs_stepper *st, double v)
+{
+    st->lp_min_force = v;
+}
+
 int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_jam_lp_report *rep)
 {
     if (!st) return ODHS_E_NULL;
@@ -365,33 +398,45 @@ int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_j
     memset(&w, 0, sizeof w);
     double *x0 = odhs__malloc_array(st->nd, sizeof *x0);
     if (!x0) return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
-    if ((s = lp_chain(st, &o, &w, &r))) goto done;
-    /* commit: the stepper moves its system (as a step does) and is reset on
-     * the packing; a failed reset puts both back */
-    double L0[3];
-    memcpy(x0, sys->x, st->nd * sizeof *x0);
-    memcpy(L0, sys->L, sizeof L0);
-    memcpy(sys->x, w.xc, st->nd * sizeof *w.xc);
-    memcpy(sys->L, w.Lc, sizeof w.Lc);
-    const int pre0 = st->pre_state;
-    if ((s = odhs_stepper_reset(st))) {
-        char msg[ODHS_ERRMSG_LEN];
-        memcpy(msg, st->errmsg, sizeof msg);
-        memcpy(sys->x, x0, st->nd * sizeof *x0);
-        memcpy(sys->L, L0, sizeof L0);
-        odhs__net_geometry(st->net, sys); /* the gaps and normals of the start */
-        st->ready = 1;
-        st->jammed = 0;
-        st->pre_state = pre0;
-        memcpy(st->errmsg, msg, sizeof msg);
-        goto done;
-    }
-    odhs_system_packing_fraction(sys, &r.phi_lp);
-    /* the end game: normally jammed at the reset */
-    while (!st->jammed && r.end_steps < o.max_steps) {
-        s = odhs_stepper_step(st, NULL);
-        if (s == ODHS_OK || s == ODHS_STOPPED || s == ODHS_JAMMED) r.end_steps++;
-        if (s != ODHS_OK && s != ODHS_STOPPED) break;
+    /* a packing with a backbone contact of zero force (a degenerate vertex of
+     * the last programme: seen at 2D N = 4096) can still be compressed: it
+     * is shaken (LP_SHAKE_*) and the chain runs again, at most LP_SHAKES
+     * times */
+    for (int shake = 0;; ++shake) {
+        if ((s = lp_chain(st, &o, &w, &r, shake))) goto done;
+        /* commit: the stepper moves its system (as a step does) and is reset
+         * on the packing; a failed reset puts both back */
+        double L0[3];
+        memcpy(x0, sys->x, st->nd * sizeof *x0);
+        memcpy(L0, sys->L, sizeof L0);
+        memcpy(sys->x, w.xc, st->nd * sizeof *w.xc);
+        memcpy(sys->L, w.Lc, sizeof w.Lc);
+        const int pre0 = st->pre_state, jammed0 = st->jammed;
+        if ((s = odhs_stepper_reset(st))) {
+            char msg[ODHS_ERRMSG_LEN];
+            memcpy(msg, st->errmsg, sizeof msg);
+            memcpy(sys->x, x0, st->nd * sizeof *x0);
+            memcpy(sys->L, L0, sizeof L0);
+            odhs__net_geometry(st->net, sys); /* the gaps and normals of the start */
+            st->ready = 1;
+            st->jammed = jammed0;
+            st->pre_state = pre0;
+            memcpy(st->errmsg, msg, sizeof msg);
+            goto done;
+        }
+        odhs_system_packing_fraction(sys, &r.phi_lp);
+        /* the end game: normally jammed at the reset */
+        while (!st->jammed && r.end_steps < o.max_steps) {
+            s = odhs_stepper_step(st, NULL);
+            if (s == ODHS_OK || s == ODHS_STOPPED || s == ODHS_JAMMED) r.end_steps++;
+            if (s != ODHS_OK && s != ODHS_STOPPED) break;
+        }
+        if (!st->jammed || shake == LP_SHAKES) break;
+        odhs_jam_certificate c;
+        c.size = sizeof c;
+        if ((s = odhs_stepper_certificate(st, &c))) goto done;
+        if (c.min_force > (st->lp_min_force > 0.0 ? st->lp_min_force : LP_MIN_FORCE)) break;
+        r.shakes++;
     }
     if (st->jammed) {
         s = odhs__sterr(st, ODHS_JAMMED, "jammed by %zu linear programmes and %llu event-driven steps at phi = %.15g",

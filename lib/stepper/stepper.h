@@ -13,6 +13,9 @@
 int odhs__stepper_check_neighbours(odhs_stepper *st);
 /* tests: 1 = always the anti-cycling rewiring, 0 = the paper's rule first */
 int odhs__stepper_set_rewire_mode(odhs_stepper *st, int mode);
+/* tests: the smallest backbone force (relative to the mean) below which
+ * odhs_stepper_jam_lp shakes a packing (lib/jamming/lp.c; 0: its default) */
+void odhs__stepper_set_lp_min_force(odhs_stepper *st, double v);
 
 /* ---- stepper ------------------------------------------------------------------ */
 typedef struct {
@@ -75,6 +78,7 @@ struct odhs_stepper {
     int rewire_mode;            /* 0: paper's rule, anti-cycling takeover; 1: anti-cycling only (tests) */
     uint64_t nrewire_monotone;  /* rewirings the anti-cycling method finished (not checkpointed) */
     uint64_t njam_pivots;       /* pivots of jam_finish on the final packing (not checkpointed) */
+    double lp_min_force;        /* tests: jam_lp's degeneracy threshold (0: default; lp.c) */
     /* fixed pressure through the network without contact iso_k (pressure.c):
      * scratch vectors in fpj (f0 and freg first, nc each); pj_bordered while
      * the velocities are S^T freg + pj_alpha pj_res (res: nd, then nd of
