@@ -80,9 +80,9 @@ static int jam_lp(odhs_stepper *st, double trust, int quiet)
     if (!quiet && rc == ODHS_JAMMED)
         fprintf(stderr,
                 "jam_packing: %zu linear programmes (%llu simplex iterations, at most %zu pairs), phi = %.12f; "
-                "end game: %llu event-driven steps; %zu degenerate packings shaken\n",
+                "end game: %llu event-driven steps; %zu degenerate packings shaken, %zu extra polishes\n",
                 r.n_lps, (unsigned long long)r.simplex_iterations, r.rows_max, r.phi_lp,
-                (unsigned long long)r.end_steps, r.shakes);
+                (unsigned long long)r.end_steps, r.shakes, r.polishes);
     return rc;
 }
 

@@ -100,6 +100,7 @@ typedef struct odhs_jam_lp_report {
     double growth_last;          /* sqrt(Gamma) - 1 of the last programme         */
     uint64_t end_steps;          /* event-driven steps of the end game (usually 0) */
     size_t shakes;               /* degenerate packings shaken and jammed again    */
+    size_t polishes;             /* extra polishes of the packing's contact gaps   */
 } odhs_jam_lp_report;
 
 /**
@@ -122,6 +123,10 @@ typedef struct odhs_jam_lp_report {
  * tolerance) as its network, and steps under the compression until
  * ODHS_JAMMED (normally at once), with the rewiring, self-stress, polish and
  * final pivots of a compression run.
+ *
+ * The chain ends with contact gaps up to the LP solver's tolerance; when
+ * the end game's polish leaves gaps above 1e-14 (relative), the end game
+ * runs again on the packing, at most twice (report.polishes).
  *
  * A packing whose smallest backbone force is below 1e-9 of the mean (a
  * degenerate vertex of the last programme: a contact that carries no force

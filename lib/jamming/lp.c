@@ -48,6 +48,8 @@
 #define LP_FEAS 1e-10       /* CLP's primal and dual feasibility tolerances */
 #define LP_SHAKES 3         /* shakes of a degenerate packing at most */
 #define LP_MIN_FORCE 1e-9   /* a backbone force below this (relative to the mean) is degenerate */
+#define LP_GAP 1e-14        /* contact gaps (relative) above this get another polish ... */
+#define LP_POLISHES 2       /* ... at most this many */
 
 /* the fields of the options and the report the caller's size must cover */
 #define LP_OPT_MIN (offsetof(odhs_jam_lp_options, max_steps) + sizeof(size_t))
@@ -432,10 +434,18 @@ int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_j
             if (s == ODHS_OK || s == ODHS_STOPPED || s == ODHS_JAMMED) r.end_steps++;
             if (s != ODHS_OK && s != ODHS_STOPPED) break;
         }
-        if (!st->jammed || shake == LP_SHAKES) break;
+        if (!st->jammed) break;
         odhs_jam_certificate c;
         c.size = sizeof c;
         if ((s = odhs_stepper_certificate(st, &c))) goto done;
+        /* the chain ends with contact gaps up to CLP's feasibility tolerance,
+         * which one polish brings to ~1e-13 at N = 4096: polish again (the
+         * end game once more: polish, f0, pivots, rattlers, f0 check) */
+        for (int k = 0; k < LP_POLISHES && c.gap_error > LP_GAP; ++k) {
+            if ((s = odhs__st_jam_finish(st)) || (s = odhs_stepper_certificate(st, &c))) goto done;
+            r.polishes++;
+        }
+        if (shake == LP_SHAKES) break;
         if (c.min_force > (st->lp_min_force > 0.0 ? st->lp_min_force : LP_MIN_FORCE)) break;
         r.shakes++;
     }

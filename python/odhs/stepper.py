@@ -637,7 +637,7 @@ class Stepper(Owned):
         rc = lib.odhs_stepper_jam_lp(self._p or self._closed(), o, r)
         st = self._run_result(rc, "Stepper.jam_lp")
         return st, JamLpReport(int(r.n_lps), int(r.simplex_iterations), int(r.rows_max), r.phi_lp, r.growth_last,
-                               int(r.end_steps), int(r.shakes))
+                               int(r.end_steps), int(r.shakes), int(r.polishes))
 
     # --- files -------------------------------------------------------------------------------
     def write_checkpoint(self, path):
