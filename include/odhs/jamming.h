@@ -158,7 +158,9 @@ typedef struct odhs_jam_lp_report {
  * failed reset on the packing leave the stepper and its system as they were.
  * The end game's steps are steps: one that fails is undone, the ones before
  * it stay (as in odhs_stepper_run_until_*), and ODHS_E_STALLED after
- * max_steps leaves the state reached.
+ * max_steps leaves the state reached. The checks on the jammed packing
+ * (another polish, a shake) are skipped when memory runs out: the packing
+ * is then returned as the end game made it.
  */
 ODHS_API int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_jam_lp_report *rep);
 

@@ -435,17 +435,39 @@ int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_j
             if (s != ODHS_OK && s != ODHS_STOPPED) break;
         }
         if (!st->jammed) break;
+        /* The checks below improve a packing that is already jammed; out of
+         * memory they are skipped (the packing is returned as the end game
+         * made it), since the stepper has moved on and cannot go back. */
         odhs_jam_certificate c;
         c.size = sizeof c;
-        if ((s = odhs_stepper_certificate(st, &c))) goto done;
+        int e = odhs_stepper_certificate(st, &c);
+        if (e == ODHS_E_NOMEM) break;
+        if (e) {
+            s = e;
+            goto done;
+        }
         /* the chain ends with contact gaps up to CLP's feasibility tolerance,
          * which one polish brings to ~1e-13 at N = 4096: polish again (the
-         * end game once more: polish, f0, pivots, rattlers, f0 check) */
+         * end game once more: polish, f0, pivots, rattlers, f0 check); a
+         * failed polish is undone */
         for (int k = 0; k < LP_POLISHES && c.gap_error > LP_GAP; ++k) {
-            if ((s = odhs__st_jam_finish(st)) || (s = odhs_stepper_certificate(st, &c))) goto done;
+            const uint64_t piv0 = st->njam_pivots;
+            if ((e = odhs__st_save(st))) break;
+            if (odhs__st_jam_finish(st)) { /* any failure: keep the packing before it */
+                odhs__st_rollback(st);
+                st->jammed = 1;
+                st->njam_pivots = piv0;
+                st->errmsg[0] = '\0';
+                break;
+            }
             r.polishes++;
+            if ((e = odhs_stepper_certificate(st, &c))) break;
         }
-        if (shake == LP_SHAKES) break;
+        if (e && e != ODHS_E_NOMEM) {
+            s = e;
+            goto done;
+        }
+        if (e || shake == LP_SHAKES) break;
         if (c.min_force > (st->lp_min_force > 0.0 ? st->lp_min_force : LP_MIN_FORCE)) break;
         r.shakes++;
     }
