@@ -332,8 +332,9 @@ static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, 
         return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
     memcpy(w->xc, sys->x, st->nd * sizeof *w->xc);
     memcpy(w->Lc, sys->L, sizeof w->Lc);
-    /* after a shake the basis of the last programme (kept in w) warm-starts
-     * the first one: the pairs are the same */
+    /* a new start, also after a shake: no warm start (from the basis of a
+     * degenerate packing the chain returns to it: 2D N = 4096, seed 1) */
+    w->nbasis = 0;
     if (shake) {
         double lam0 = 0.0;
         for (size_t i = 0; i < st->n; ++i) lam0 += 2.0 * sys->r[i] / (double)st->n;
