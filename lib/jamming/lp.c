@@ -144,6 +144,7 @@ typedef struct {
     unsigned char *status;
     lp_basis *basis;
     size_t nbasis, cap_start, cap_row, cap_val, cap_rlo, cap_rup, cap_status, cap_basis;
+    double smin; /* the smallest diameter */
 } lp_work;
 
 static void lp_free(lp_work *w)
@@ -173,11 +174,7 @@ static int lp_solve(odhs_stepper *st, lp_work *w, double ell, odhs_jam_lp_report
     odhs_system *sys = st->sys;
     const int d = st->dim;
     const size_t n = st->n, nd = st->nd;
-    double smin = INFINITY, smax = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        smin = fmin(smin, 2.0 * sys->r[i]);
-        smax = fmax(smax, 2.0 * sys->r[i]);
-    }
+    const double smin = w->smin, smax = 2.0 * sys->rmax;
     const double groot = 1.0 + 2.0 * ell / smin; /* bound on sqrt(Gamma) */
     const double cut = 2.0 * sqrt((double)d) * ell + (groot - 1.0) * smax;
     w->pr.m = 0;
@@ -299,18 +296,8 @@ static void lp_apply(odhs_stepper *st, lp_work *w, double g)
     const double f = 1.0 / sqrt(g);
     for (size_t k = 0; k < st->nd; ++k) w->xc[k] += w->s[k];
     for (size_t i = 0; i < st->n; ++i) odhs__wrap(d, w->Lc, st->sys->gamma, w->xc + i * (size_t)d);
-    for (size_t k = 0; k < st->nd; ++k) w->xc[k] *= f;
+    for (size_t k = 0; k < st->nd; ++k) w->xc[k] *= f; /* still inside the shrunk box */
     for (int a = 0; a < d; ++a) w->Lc[a] *= f;
-    for (size_t i = 0; i < st->n; ++i) odhs__wrap(d, w->Lc, st->sys->gamma, w->xc + i * (size_t)d);
-}
-
-/* splitmix64: the shake's deterministic noise (no global state) */
-static uint64_t lp_mix(uint64_t z)
-{
-    z += 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
 }
 
 /* The chain on private copies of the configuration (w->xc, w->Lc): the
@@ -335,25 +322,21 @@ static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, 
     /* a new start, also after a shake: no warm start (from the basis of a
      * degenerate packing the chain returns to it: 2D N = 4096, seed 1) */
     w->nbasis = 0;
-    if (shake) {
-        double lam0 = 0.0;
-        for (size_t i = 0; i < st->n; ++i) lam0 += 2.0 * sys->r[i] / (double)st->n;
+    if (shake) { /* the noise: the library's generator, seeded by the shake's number */
+        odhs_rng rng;
+        odhs__rng_seed(&rng, (uint64_t)shake);
         for (int a = 0; a < d; ++a) w->Lc[a] *= 1.0 + LP_SHAKE_DILATE;
-        for (size_t k = 0; k < st->nd; ++k) {
-            double u = (double)(lp_mix((uint64_t)k * 4u + (uint64_t)shake) >> 11) * 0x1.0p-53;
-            w->xc[k] = w->xc[k] * (1.0 + LP_SHAKE_DILATE) + LP_SHAKE_NOISE * lam0 * (2.0 * u - 1.0);
-        }
+        for (size_t k = 0; k < st->nd; ++k)
+            w->xc[k] = w->xc[k] * (1.0 + LP_SHAKE_DILATE) +
+                       LP_SHAKE_NOISE * st->lambda * (2.0 * odhs__rng_uniform(&rng) - 1.0);
         for (size_t i = 0; i < st->n; ++i) odhs__wrap(d, w->Lc, sys->gamma, w->xc + i * (size_t)d);
     }
     /* the trust region, and a cut-off the cell search allows (half the
      * shortest box edge minus the largest diameter) */
-    double smin = INFINITY, smax = 0.0, lam = 0.0;
-    for (size_t i = 0; i < st->n; ++i) {
-        smin = fmin(smin, 2.0 * sys->r[i]);
-        smax = fmax(smax, 2.0 * sys->r[i]);
-        lam += 2.0 * sys->r[i] / (double)st->n;
-    }
-    const double ell = o->trust * lam, per_ell = 2.0 * sqrt((double)d) + 2.0 * smax / smin;
+    w->smin = INFINITY;
+    for (size_t i = 0; i < st->n; ++i) w->smin = fmin(w->smin, 2.0 * sys->r[i]);
+    const double lam = st->lambda; /* the mean diameter (set by the reset) */
+    const double ell = o->trust * lam, per_ell = 2.0 * sqrt((double)d) + 2.0 * sys->rmax / w->smin;
     int s;
     for (size_t k = 0; k < o->max_lps; ++k) {
         double lmin = fmin(w->Lc[0], w->Lc[1]);
