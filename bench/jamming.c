@@ -47,12 +47,13 @@
  *  4. (not in the default "123") the routes side by side from the same
  *     starts, seeds 1..ODHS_BENCH_ROUTE_SEEDS (default 5), sizes
  *     ODHS_BENCH_ROUTE_SIZES (default 2:256,2:1024,3:343,3:1000), routes
- *     ODHS_BENCH_ROUTES (default lp,events,soft,lammps): the fast route
+ *     ODHS_BENCH_ROUTES (default quench,lp,events,soft,lammps): the fast
+ *     route from its quench start and from the configuration
  *     (odhs_stepper_jam_lp), the event-driven compression, the soft-sphere
  *     route of table 3, and LAMMPS (lmp, Debian package lammps) running the
  *     O'Hern protocol from an input this program writes; a route missing
  *     from the machine is reported as skipped. CPU seconds per packing and
- *     their ratio to the fast route. ODHS_BENCH_SOFT_LIMIT bounds each run.
+ *     their ratio to the first route run. ODHS_BENCH_SOFT_LIMIT bounds each run.
  *
  * Every packing runs in a child process (fork), so a run that exceeds its
  * time limit is killed and reported instead of stalling the benchmark.
@@ -101,7 +102,7 @@ typedef struct {
     uint64_t s_mins, s_iters; /* minimisations and FIRE iterations           */
     /* table 4: lp = the fast route (odhs_stepper_jam_lp), lammps = LAMMPS
      * doing the soft-sphere route (s_phi_lo/hi, s_mins) */
-    int lp, lammps;
+    int lp, lammps; /* lp: 1 from the configuration, 2 from the quench start */
     odhs_jam_lp_report lprep;
 } result;
 
@@ -341,7 +342,8 @@ static void run_packing(result *r, int f0_check)
     if (!r->rc) r->rc = odhs_stepper_create(sys, drv, sol, &st);
     if (!r->rc) r->rc = odhs_stepper_set_correction_interval(st, correction);
     r->lprep.size = sizeof r->lprep;
-    if (!r->rc) r->rc = r->lp ? odhs_stepper_jam_lp(st, NULL, &r->lprep) : odhs_stepper_run_until_packing_fraction(st, 0.999);
+    odhs_jam_lp_options lo = {.size = sizeof lo, .quench = r->lp == 2};
+    if (!r->rc) r->rc = r->lp ? odhs_stepper_jam_lp(st, &lo, &r->lprep) : odhs_stepper_run_until_packing_fraction(st, 0.999);
     r->wall = bench_wall() - t0;
     r->cpu = bench_cpu() - c0;
     if (st) {
@@ -611,11 +613,11 @@ static int parse_sizes(const char *name, size_spec *sizes, int *ns)
 /* ---- table 4: the routes side by side (issue 22) ------------------------------------ */
 /* ODHS_BENCH_ROUTE_SIZES (dim:N,...; default 2:256,2:1024,3:343,3:1000),
  * ODHS_BENCH_ROUTE_SEEDS (seeds 1..S, default 5) and ODHS_BENCH_ROUTES (a
- * comma list of lp, events, soft, lammps; default all four). Every run of
+ * comma list of quench, lp, events, soft, lammps; default all five). Every run of
  * a size starts from the same placements; LAMMPS is skipped (reported) when
  * lmp is not installed. */
-enum { R_LP, R_EVENTS, R_SOFT, R_LAMMPS, R_N };
-static const char *const route_names[R_N] = {"lp", "events", "soft", "lammps"};
+enum { R_QUENCH, R_LP, R_EVENTS, R_SOFT, R_LAMMPS, R_N };
+static const char *const route_names[R_N] = {"quench", "lp", "events", "soft", "lammps"};
 
 static int table4(int workers, double limit)
 {
@@ -626,9 +628,14 @@ static int table4(int workers, double limit)
     int seeds = se && atoi(se) > 0 ? atoi(se) : 5;
     if (seeds > 50) seeds = 50;
     const char *re = getenv("ODHS_BENCH_ROUTES");
-    int want[R_N] = {1, 1, 1, 1};
-    if (re && *re)
-        for (int k = 0; k < R_N; ++k) want[k] = strstr(re, route_names[k]) != NULL;
+    int want[R_N] = {1, 1, 1, 1, 1};
+    if (re && *re) /* whole names of the comma list */
+        for (int k = 0; k < R_N; ++k) {
+            size_t l = strlen(route_names[k]);
+            want[k] = 0;
+            for (const char *p = re; (p = strstr(p, route_names[k])) != NULL; p += l)
+                if ((p == re || p[-1] == ',') && (p[l] == '\0' || p[l] == ',')) want[k] = 1;
+        }
     result *runs = calloc((size_t)ns * R_N * (size_t)seeds, sizeof *runs);
     if (!runs) return 1;
     size_t nr = 0;
@@ -639,7 +646,7 @@ static int table4(int workers, double limit)
                 r->dim = sizes[z].dim;
                 r->n = sizes[z].n;
                 r->seed = (unsigned)(q + 1);
-                r->lp = k == R_LP;
+                r->lp = k == R_LP ? 1 : k == R_QUENCH ? 2 : 0;
                 r->soft = k == R_SOFT;
                 r->lammps = k == R_LAMMPS;
                 if (!want[k]) r->wall = -2.0; /* not asked for */
@@ -654,16 +661,17 @@ static int table4(int workers, double limit)
         k = e - 1;
     }
     printf("\n## Table 4: routes to a jammed packing side by side, the same %d starts per size (seeds 1-%d)\n"
-           "##   lp = odhs_stepper_jam_lp (chain of linear programmes + exact end game), events = event-driven\n"
+           "##   quench = odhs_stepper_jam_lp from its quench start (soft-sphere quench to phi 0.86, 3D 0.66, then\n"
+           "##   the chain), lp = odhs_stepper_jam_lp (chain of linear programmes + exact end game), events = event-driven\n"
            "##   compression, soft = the library's soft-sphere route (table 3), lammps = LAMMPS (lmp) doing the\n"
            "##   O'Hern protocol from phi 0.70 (3D: 0.50) (harmonic, FIRE to 1e-14, bisection to 1e-6). CPU s per packing;\n"
-           "##   ratio = route CPU / lp CPU. phi_J: certified packings for lp and events, the last unjammed phi\n"
-           "##   for the soft routes.\n",
+           "##   ratio = route CPU / CPU of the first route listed. phi_J: certified packings for quench, lp and\n"
+           "##   events, the last unjammed phi for the soft routes.\n",
            seeds, seeds);
     printf("%-3s %6s %-7s %5s %9s %10s %10s %11s %9s %8s %s\n", "d", "N", "route", "runs", "certified", "cpu_s",
            "cpu_max", "phi_J", "phi_sd", "ratio", "work");
     for (int z = 0; z < ns; ++z) {
-        double lp_cpu = NAN;
+        double lp_cpu = NAN; /* the first route listed */
         for (int k = 0; k < R_N; ++k) {
             const result *rr = &runs[((size_t)z * R_N + (size_t)k) * (size_t)seeds];
             if (rr[0].wall == -2.0) continue;
@@ -676,7 +684,7 @@ static int table4(int workers, double limit)
                 if (r->wall < 0) continue;
                 run++;
                 if (r->lammps && r->rc == ODHS_E_NOTINSTALLED) missing = 1;
-                int good = r->done && (k == R_LP || k == R_EVENTS ? r->rc == ODHS_JAMMED : r->rc == ODHS_OK);
+                int good = r->done && (k <= R_EVENTS ? r->rc == ODHS_JAMMED : r->rc == ODHS_OK);
                 if (!good) continue;
                 ok++;
                 cert += (size_t)r->certified;
@@ -684,7 +692,7 @@ static int table4(int workers, double limit)
                 cmax = fmax(cmax, r->cpu);
                 ph += r->cert.phi;
                 ph2 += r->cert.phi * r->cert.phi;
-                work += k == R_LP       ? r->lprep.n_lps
+                work += k <= R_LP       ? r->lprep.n_lps
                         : k == R_EVENTS ? r->steps
                                         : r->s_mins;
             }
@@ -700,13 +708,13 @@ static int table4(int workers, double limit)
             }
             double m = (double)ok, mean = ph / m, sd = ok > 1 ? sqrt(fmax(0.0, (ph2 - m * mean * mean) / (m - 1))) : 0;
             cpu /= m;
-            if (k == R_LP) lp_cpu = cpu;
+            if (lp_cpu != lp_cpu) lp_cpu = cpu;
             char cs[16];
-            if (k == R_LP || k == R_EVENTS) snprintf(cs, sizeof cs, "%zu/%zu", cert, run);
+            if (k <= R_EVENTS) snprintf(cs, sizeof cs, "%zu/%zu", cert, run);
             else snprintf(cs, sizeof cs, "-");
             printf("%-3d %6zu %-7s %5zu %9s %10.2f %10.2f %11.6f %9.5f %8.2f %llu %s\n", sizes[z].dim, sizes[z].n,
                    route_names[k], run, cs, cpu, cmax, mean, sd, cpu / lp_cpu, work / (unsigned long long)ok,
-                   k == R_LP ? "programmes" : k == R_EVENTS ? "steps" : "minimisations");
+                   k <= R_LP ? "programmes" : k == R_EVENTS ? "steps" : "minimisations");
             if (csv)
                 fprintf(csv, "routes,%d,%zu,%zu,%zu,%zu,%.9f,%.3e,,,,,%.2f,%.2f,%llu,,,,,,%s\n", sizes[z].dim,
                         sizes[z].n, run, ok, cert, mean, sd, cpu, cmax, work / (unsigned long long)ok,
@@ -718,7 +726,7 @@ static int table4(int workers, double limit)
             const result *r = &runs[k];
             if (r->wall < 0) continue;
             fprintf(csv, "run:routes,%d,%zu,seed %u,rc %d,%s,%d,%.12f,,,,,%.2f,%.2f,,,,,,,%s\n", r->dim, r->n, r->seed,
-                    r->rc, r->lp ? "lp" : r->soft ? "soft" : r->lammps ? "lammps" : "events", r->certified,
+                    r->rc, r->lp == 2 ? "quench" : r->lp ? "lp" : r->soft ? "soft" : r->lammps ? "lammps" : "events", r->certified,
                     r->cert.phi, r->wall, r->cpu, r->done ? "" : "killed at the time limit");
         }
     free(runs);

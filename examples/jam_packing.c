@@ -19,8 +19,8 @@
 enum { COMPRESS, SHEAR, SHEAR_COMPRESS, PRESSURE };
 static const char *const protocols[] = {"compress", "shear", "shear+compress", "pressure", NULL};
 /* --method */
-enum { EVENTS, LP };
-static const char *const methods[] = {"events", "lp", NULL};
+enum { EVENTS, LP, QUENCH_LP };
+static const char *const methods[] = {"events", "lp", "quench+lp", NULL};
 
 /* the integration settings of the options */
 static int configure(odhs_stepper *st, int integrator, double dt, double tol, unsigned long corr)
@@ -72,11 +72,14 @@ static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, do
 }
 
 /* --method lp: the chain of linear programmes and the exact end game */
-static int jam_lp(odhs_stepper *st, double trust, int quiet)
+static int jam_lp(odhs_stepper *st, double trust, int quench, double quench_phi, int quiet)
 {
-    odhs_jam_lp_options o = {.size = sizeof o, .trust = trust};
+    odhs_jam_lp_options o = {.size = sizeof o, .trust = trust, .quench = quench, .quench_phi = quench_phi};
     odhs_jam_lp_report r = {.size = sizeof r};
     int rc = odhs_stepper_jam_lp(st, &o, &r);
+    if (!quiet && rc == ODHS_JAMMED && quench)
+        fprintf(stderr, "jam_packing: quench: %llu FIRE iterations; the chain started at phi = %.6f\n",
+                (unsigned long long)r.quench_iterations, r.phi_start);
     if (!quiet && rc == ODHS_JAMMED)
         fprintf(stderr,
                 "jam_packing: %zu linear programmes (%llu simplex iterations, at most %zu pairs), phi = %.12f; "
@@ -90,7 +93,7 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double dt = 1e-3, max_strain = 20.0, tol = 1e-6, p_jam = 0.0, traj_every = 0.01, trust = 0.1;
+    double dt = 1e-3, max_strain = 20.0, tol = 1e-6, p_jam = 0.0, traj_every = 0.01, trust = 0.1, quench_phi = 0.0;
     int protocol = COMPRESS, method = EVENTS, integrator = CLI_DEFAULT_INTEGRATOR, dim = 2, quiet = 0;
     unsigned long corr = 1;
     unsigned long n = 256, seed = 1;
@@ -99,10 +102,16 @@ int main(int argc, char **argv)
         CLI_OPT_LIST("--method", &method, "M",
                      "how the compression stage (compress, shear) jams: events = the event-driven compression; lp = "
                      "a chain of linear programmes, then the same exact end game (odhs_stepper_jam_lp; needs a "
-                     "library built with COIN-OR CLP)",
+                     "library built with COIN-OR CLP); quench+lp = the fastest: a soft-sphere quench to "
+                     "--quench-phi, dilated until no pair overlaps, then lp (a quench protocol, not a compression)",
                      methods, CLI_ANY),
         CLI_OPT_DOUBLE("--trust", &trust, "X",
-                       "--method lp: bound on each displacement per programme, in mean diameters (at most 0.5)",
+                       "--method lp, quench+lp: bound on each displacement per programme, in mean diameters (at "
+                       "most 0.5)",
+                       CLI_POSITIVE),
+        CLI_OPT_DOUBLE("--quench-phi", &quench_phi, "X",
+                       "--method quench+lp: packing fraction of the quench, below 1 (default: the library's, 0.86 "
+                       "in 2D and 0.66 in 3D)",
                        CLI_POSITIVE),
         CLI_IN(&in),
         CLI_OUT(&outpath),
@@ -148,9 +157,13 @@ int main(int argc, char **argv)
         0};
     int rc = cli_parse(&cli, argc, argv);
     if (rc != CLI_GO) return rc;
-    if (method == LP && (protocol == SHEAR_COMPRESS || protocol == PRESSURE)) {
-        fprintf(stderr, "jam_packing: --method lp replaces an isotropic compression to jamming: protocols compress "
-                        "and shear only\n");
+    if (method != EVENTS && (protocol == SHEAR_COMPRESS || protocol == PRESSURE)) {
+        fprintf(stderr, "jam_packing: --method %s replaces an isotropic compression to jamming: protocols compress "
+                        "and shear only\n", methods[method]);
+        return 2;
+    }
+    if (quench_phi >= 1.0) {
+        fprintf(stderr, "jam_packing: --quench-phi %g: must be below 1\n", quench_phi);
         return 2;
     }
     if (trust > 0.5) {
@@ -184,10 +197,10 @@ int main(int argc, char **argv)
 
     if (protocol == COMPRESS) {
         odhs_driver_set_compression_rate(drv, 1.0);
-        rc = method == LP ? jam_lp(st, trust, quiet) : drive(st, drv, 0, 0, 0);
+        rc = method != EVENTS ? jam_lp(st, trust, method == QUENCH_LP, quench_phi, quiet) : drive(st, drv, 0, 0, 0);
     } else if (protocol == SHEAR) {
         odhs_driver_set_compression_rate(drv, 1.0);
-        rc = method == LP ? jam_lp(st, trust, quiet) : drive(st, drv, 0, 0, 0);
+        rc = method != EVENTS ? jam_lp(st, trust, method == QUENCH_LP, quench_phi, quiet) : drive(st, drv, 0, 0, 0);
         if (rc == ODHS_JAMMED) {
             /* dilate slightly (all contacts open) and shear at fixed volume */
             double phi;

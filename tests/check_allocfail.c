@@ -1006,14 +1006,16 @@ static void jam_final(af_fix *f, const af_scenario *sc)
 #if ODHS_HAVE_CLP
 static int jam_lp_op(af_fix *f, const af_scenario *sc, int k)
 {
-    (void)sc;
     switch (k) {
     case 0: return odhs_driver_create(&f->drv);
     case 1: return odhs_driver_set_compression_rate(f->drv, 1.0);
     case 2: return odhs_solver_create_by_name("dense", &f->sol);
     case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
     case 4: return odhs_stepper_reset(f->st);
-    case 5: return odhs_stepper_jam_lp(f->st, NULL, NULL);
+    case 5: { /* variant 1: the quench start (a system copy, the soft-core minimiser) */
+        odhs_jam_lp_options o = {.size = sizeof o, .quench = sc->variant};
+        return odhs_stepper_jam_lp(f->st, &o, NULL);
+    }
     case 6: f->cert.size = sizeof f->cert; return odhs_stepper_certificate(f->st, &f->cert);
     }
     return ODHS_E_INTERNAL;
@@ -1503,6 +1505,7 @@ static const af_scenario scenarios[] = {
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
 #if ODHS_HAVE_CLP
     {"jam_lp", 7, 0, jam_lp_setup, NULL, jam_lp_op, jam_lp_capture, jam_lp_final},
+    {"jam_quench", 7, 1, jam_lp_setup, NULL, jam_lp_op, jam_lp_capture, jam_lp_final},
 #endif
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"analysis", 6, 0, analysis_setup, NULL, analysis_op, analysis_capture, files_final},

@@ -1893,7 +1893,18 @@ static int huge_rate_case(void)
       NULL);)                                                                                                  \
     X(jam_lp_tol_negative, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                               \
       odhs_jam_lp_options o = {.size = sizeof o, .tol = -1e-12}; return odhs_stepper_jam_lp(w->run, &o,        \
-      NULL);)
+      NULL);)                                                                                                  \
+    X(jam_lp_quench_flag, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                                \
+      odhs_jam_lp_options o = {.size = sizeof o, .quench = 2}; return odhs_stepper_jam_lp(w->run, &o, NULL);)  \
+    X(jam_lp_quench_phi_one, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                             \
+      odhs_jam_lp_options o = {.size = sizeof o, .quench = 1, .quench_phi = 1.0};                              \
+      return odhs_stepper_jam_lp(w->run, &o, NULL);)                                                           \
+    X(jam_lp_quench_phi_negative, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                        \
+      odhs_jam_lp_options o = {.size = sizeof o, .quench = 1, .quench_phi = -0.5};                             \
+      return odhs_stepper_jam_lp(w->run, &o, NULL);)                                                           \
+    X(jam_lp_quench_phi_nan, odhs_stepper_jam_lp, ODHS_E_NONFINITE, NOALT, H_RUN, 0,                           \
+      odhs_jam_lp_options o = {.size = sizeof o, .quench = 1, .quench_phi = NAN_};                             \
+      return odhs_stepper_jam_lp(w->run, &o, NULL);)
 
 /* ---- traj.h, lammps.h and the outputs of 0.2.6 in io.h and stepper.h ------------------ */
 /* a trajectory of the given format in the world's directory (NULL: none) */

@@ -108,6 +108,25 @@ expect 2 "jam_packing --method lp refuses a protocol without a compression stage
     "$bin/jam_packing" --method lp --protocol pressure
 expect_in err "compress and shear only" "jam_packing says which protocols --method lp takes"
 expect 2 "jam_packing --trust beyond half a diameter" -- "$bin/jam_packing" --method lp --trust 0.7
+# the quench start (--method quench+lp): certified, in 2D and 3D and with the shear protocol
+for args in "--n 64" "--n 64 --dim 3" "--n 64 --protocol shear" "--n 64 --quench-phi 0.84"; do
+    # shellcheck disable=SC2086
+    "$bin/jam_packing" $args --method quench+lp >"$tmp/out" 2>"$tmp/err"
+    got=$?
+    if grep -q "built without an LP solver" "$tmp/err"; then
+        echo "examples-cli: jam_packing --method quench+lp skipped: the library has no LP solver (CLP)"
+    elif [ "$got" -eq 0 ] && grep -q "^certified              yes" "$tmp/out" \
+        && grep -q "quench: [1-9][0-9]* FIRE iterations; the chain started at phi = 0\.[5-8]" "$tmp/err"; then
+        pass=$((pass + 1))
+    else
+        echo "FAIL: jam_packing $args --method quench+lp: exit $got"; sed 's/^/  | /' "$tmp/err" | tail -5
+        fail=$((fail + 1))
+    fi
+done
+expect 2 "jam_packing --quench-phi at 1" -- "$bin/jam_packing" --method quench+lp --quench-phi 1
+expect 2 "jam_packing --method quench+lp refuses the pressure protocol" -- \
+    "$bin/jam_packing" --method quench+lp --protocol pressure
+expect_in err "quench+lp replaces an isotropic compression" "jam_packing says why"
 expect 2 "jam_packing bad method" -- "$bin/jam_packing" --method simplex
 head -1 "$tmp/j.con" | grep -q "^i,j,kind,force,gap$" && [ "$(awk -F, 'NR > 1 && NF != 5' "$tmp/j.con" | wc -l)" -eq 0 ] \
     && pass=$((pass + 1)) || { echo "FAIL: jam_packing contacts CSV"; fail=$((fail + 1)); }

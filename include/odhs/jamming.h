@@ -88,6 +88,10 @@ typedef struct odhs_jam_lp_options {
     double tol;       /* the chain ends when sqrt(Gamma) - 1 < tol (default 1e-12)  */
     size_t max_lps;   /* programmes at most (default 10000)                         */
     size_t max_steps; /* event-driven steps of the end game at most (default 1e5)   */
+    /* since 0.2.10: the quench start (see below) */
+    int quench;        /* 1: start from a soft-sphere quench; 0: from the configuration */
+    double quench_phi; /* the quench's packing fraction, in (0, 1) (default 0.86 in 2D,
+                        * 0.66 in 3D: above phi_J of common mixtures)                */
 } odhs_jam_lp_options;
 
 /** What odhs_stepper_jam_lp did. Set `size` to sizeof(odhs_jam_lp_report). */
@@ -101,6 +105,9 @@ typedef struct odhs_jam_lp_report {
     uint64_t end_steps;          /* event-driven steps of the end game (usually 0) */
     size_t shakes;               /* degenerate packings shaken and jammed again    */
     size_t polishes;             /* extra polishes of the packing's contact gaps   */
+    /* since 0.2.10 */
+    uint64_t quench_iterations;  /* FIRE iterations of the quench (0 without)     */
+    double phi_start;            /* packing fraction where the chain started      */
 } odhs_jam_lp_report;
 
 /**
@@ -127,6 +134,21 @@ typedef struct odhs_jam_lp_report {
  * The chain ends with contact gaps up to the LP solver's tolerance; when
  * the end game's polish leaves gaps above 1e-14 (relative), the end game
  * runs again on the packing, at most twice (report.polishes).
+ *
+ * The quench start (opt.quench = 1; since 0.2.10) is much faster near and
+ * at large N: the start is compressed affinely to quench_phi and its soft
+ * (harmonic) energy minimised by FIRE (O'Hern et al.'s quench, on a copy of
+ * the system, to a largest force of 1e-9, at most 1e6 iterations: an
+ * unfinished minimisation is used as it is), and the result is dilated
+ * until no pair overlaps; the chain starts there. Above phi_J the
+ * minimised soft packing is jammed, and its structure is close to a hard
+ * jammed packing: the chain then needs tens of programmes where a start far
+ * below jamming needs hundreds, each also cheaper (measured in
+ * docs/jamming.md: 2D N = 4096 in about 1.5 CPU min against 12). It is the
+ * protocol of an infinitely fast quench, not a compression: its packings
+ * are denser (2D N = 256, the same 12 starts: phi_J = 0.8432 +- 0.0016
+ * against 0.8377 +- 0.0031 for the event-driven compression at rate 1,
+ * standard deviations).
  *
  * A packing whose smallest backbone force is below 1e-9 of the mean (a
  * degenerate vertex of the last programme: a contact that carries no force

@@ -14,6 +14,9 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
 int odhs__jam_pair_stress(const odhs_network *net, odhs_solver *sol, const double *f0, size_t i, size_t j,
                           const double *nrm, double dist, double *h);
 int odhs__null_vector(const odhs_network *net, odhs_solver *solver, double *f0, double *residual);
+/* the same; refine = 1: one step of iterative refinement of the sparse
+ * solve (the final f0 of a jammed packing) */
+int odhs__null_vector_ex(const odhs_network *net, odhs_solver *solver, double *f0, double *residual, int refine);
 /* fixed pressure: the kernel vector fs of S^T with <r|fs> = 0 (the volume as
  * one more column of S) on a constrained subset with d(Nbar - 1) + 2
  * contacts, max |fs| = 1, sign undetermined; by the SVD of that matrix

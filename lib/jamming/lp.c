@@ -34,6 +34,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "odhs/softcore.h"
+
+#include "geom/geom.h"
 #include "stepper/stepper.h"
 #include "system/system.h"
 
@@ -50,6 +53,10 @@
 #define LP_MIN_FORCE 1e-9   /* a backbone force below this (relative to the mean) is degenerate */
 #define LP_GAP 1e-14        /* contact gaps (relative) above this get another polish ... */
 #define LP_POLISHES 2       /* ... at most this many */
+#define LP_QUENCH_PHI_2D 0.86 /* default packing fraction of the quench start, 2D */
+#define LP_QUENCH_PHI_3D 0.66 /* ... and 3D */
+#define LP_QUENCH_FORCE 1e-9  /* the quench's FIRE stops at this largest force ... */
+#define LP_QUENCH_ITER 1000000 /* ... or after this many iterations */
 
 /* the fields of the options and the report the caller's size must cover */
 #define LP_OPT_MIN (offsetof(odhs_jam_lp_options, max_steps) + sizeof(size_t))
@@ -73,6 +80,12 @@ static int lp_settings(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_ja
     if (o->trust > 0.5)
         return odhs__sterr(st, ODHS_E_INVALID,
                            "jam_lp options: trust %g is more than half a mean diameter per programme", o->trust);
+    if (o->quench != 0 && o->quench != 1)
+        return odhs__sterr(st, ODHS_E_INVALID, "jam_lp options: quench = %d (0: no quench, 1: quench start)", o->quench);
+    if (!isfinite(o->quench_phi) || o->quench_phi < 0.0 || o->quench_phi >= 1.0)
+        return odhs__sterr(st, o->quench_phi != o->quench_phi || isinf(o->quench_phi) ? ODHS_E_NONFINITE : ODHS_E_INVALID,
+                           "jam_lp options: quench_phi = %g must be in (0, 1) (0: default)", o->quench_phi);
+    if (o->quench_phi == 0.0) o->quench_phi = st->dim == 2 ? LP_QUENCH_PHI_2D : LP_QUENCH_PHI_3D;
     if (o->trust == 0.0) o->trust = LP_TRUST;
     if (o->tol == 0.0) o->tol = LP_TOL;
     if (o->max_lps == 0) o->max_lps = LP_MAX;
@@ -141,6 +154,7 @@ typedef struct {
     int *start, *row;
     double *val, *rlo, *rup, *clo, *cup, *obj, *xc, *s;
     double Lc[3]; /* the chain's configuration: positions xc, box Lc */
+    double *xq, Lq[3]; /* the quench start (NULL: none) */
     unsigned char *status;
     lp_basis *basis;
     size_t nbasis, cap_start, cap_row, cap_val, cap_rlo, cap_rup, cap_status, cap_basis;
@@ -164,6 +178,7 @@ static void lp_free(lp_work *w)
     odhs__free(w->s);
     odhs__free(w->status);
     odhs__free(w->basis);
+    odhs__free(w->xq);
 }
 
 /* One programme around the current configuration; *g receives the growth
@@ -300,6 +315,61 @@ static void lp_apply(odhs_stepper *st, lp_work *w, double g)
     for (int a = 0; a < d; ++a) w->Lc[a] *= f;
 }
 
+/* The quench start on a copy of the system: affine compression to
+ * o->quench_phi, FIRE on the harmonic soft-sphere energy, and a dilation
+ * until no pair overlaps (w->xq, w->Lq). */
+typedef struct {
+    const double *r;
+    double f; /* the largest sigma / |r_ij| */
+} lp_dilate_ctx;
+
+static int lp_dilate_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
+{
+    (void)gap;
+    lp_dilate_ctx *c = vctx;
+    double r2 = rij[0] * rij[0] + rij[1] * rij[1] + rij[2] * rij[2];
+    double f = (c->r[i] + c->r[j]) / sqrt(r2);
+    if (f > c->f) c->f = f;
+    return 0;
+}
+
+static int lp_quench(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, odhs_jam_lp_report *rep)
+{
+    odhs_system *tmp = NULL;
+    odhs_softcore *sc = NULL;
+    int s;
+    if ((s = odhs_system_clone(st->sys, &tmp))) goto fail;
+    if ((s = odhs_softcore_create(tmp, &sc)) || (s = odhs_softcore_set_minimiser(sc, ODHS_SOFTCORE_FIRE)) ||
+        (s = odhs_softcore_set_min_tolerance(sc, LP_QUENCH_FORCE, LP_QUENCH_ITER)))
+        goto fail;
+    double phi;
+    odhs_system_packing_fraction(tmp, &phi);
+    if (o->quench_phi > phi && (s = odhs_softcore_scale_box(sc, pow(phi / o->quench_phi, 1.0 / st->dim)))) goto fail;
+    uint64_t it = 0;
+    s = odhs_softcore_minimise(sc, &it);
+    if (s == ODHS_E_NOCONV) s = ODHS_OK, it = LP_QUENCH_ITER; /* used as it is (rolled back: the affine start) */
+    if (s) goto fail;
+    rep->quench_iterations = it;
+    odhs_softcore_destroy(sc);
+    sc = NULL;
+    lp_dilate_ctx c = {tmp->r, 1.0};
+    s = odhs__pairs(st->dim, st->n, tmp->x, tmp->r, tmp->rmax, tmp->L, tmp->gamma, 0.0, lp_dilate_cb, &c);
+    if (s) goto fail;
+    const double f = c.f * (1.0 + 1e-12); /* a margin against the round-off of the scaling */
+    if (!(w->xq = odhs__malloc_array(st->nd, sizeof *w->xq))) {
+        s = ODHS_E_NOMEM;
+        goto fail;
+    }
+    for (size_t k = 0; k < st->nd; ++k) w->xq[k] = tmp->x[k] * f;
+    for (int a = 0; a < 3; ++a) w->Lq[a] = tmp->L[a] * (a < st->dim ? f : 1.0);
+    odhs_system_destroy(tmp);
+    return ODHS_OK;
+fail:
+    odhs_softcore_destroy(sc);
+    odhs_system_destroy(tmp);
+    return odhs__sterr(st, s, "jam_lp: the quench start failed: %s", odhs_strerror(s));
+}
+
 /* The chain on private copies of the configuration (w->xc, w->Lc): the
  * stepper and its system are not touched. shake > 0: the start is first
  * dilated by LP_SHAKE_DILATE and every coordinate moved by a deterministic
@@ -317,8 +387,15 @@ static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, 
          !(w->obj = odhs__malloc_array(nc, sizeof *w->obj)) || !(w->xc = odhs__malloc_array(st->nd, sizeof *w->xc)) ||
          !(w->s = odhs__malloc_array(st->nd, sizeof *w->s))))
         return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
-    memcpy(w->xc, sys->x, st->nd * sizeof *w->xc);
-    memcpy(w->Lc, sys->L, sizeof w->Lc);
+    const int q = w->xq && !shake; /* the first chain starts at the quench, if any */
+    memcpy(w->xc, q ? w->xq : sys->x, st->nd * sizeof *w->xc);
+    memcpy(w->Lc, q ? w->Lq : sys->L, sizeof w->Lc);
+    if (!shake) { /* the system's packing fraction, scaled to the start's volume */
+        double phi, V = 1.0;
+        odhs_system_packing_fraction(sys, &phi);
+        for (int a = 0; a < d; ++a) V *= sys->L[a] / w->Lc[a];
+        rep->phi_start = phi * V;
+    }
     /* a new start, also after a shake: no warm start (from the basis of a
      * degenerate packing the chain returns to it: 2D N = 4096, seed 1) */
     w->nbasis = 0;
@@ -389,6 +466,7 @@ int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_j
      * the last programme: seen at 2D N = 4096) can still be compressed: it
      * is shaken (LP_SHAKE_*) and the chain runs again, at most LP_SHAKES
      * times */
+    if (o.quench && (s = lp_quench(st, &o, &w, &r))) goto done;
     for (int shake = 0;; ++shake) {
         if ((s = lp_chain(st, &o, &w, &r, shake))) goto done;
         /* commit: the stepper moves its system (as a step does) and is reset

@@ -293,7 +293,7 @@ int odhs__st_jam_finish(odhs_stepper *st)
     for (int piv = 0;; ++piv) {
         if ((s = odhs__jam_polish(st->sys, net, st->sol, net->f)))
             return odhs__sterr(st, s, "polishing the jammed packing: %s", odhs_strerror(s));
-        if ((s = odhs__null_vector(net, st->sol, net->f, NULL)))
+        if ((s = odhs__null_vector_ex(net, st->sol, net->f, NULL, 1)))
             return odhs__sterr(st, s == ODHS_E_NOMEM ? s : ODHS_POTENTIALLY_JAMMED, "jammed packing: %s", net->errmsg);
         int pivoted = 0;
         if (piv == JAM_PIVOTS || net->nwalls || (s = jam_pivot(st, &pivoted)) || !pivoted) break;

@@ -139,3 +139,22 @@ def test_jam_lp_certified():
     c = st.certificate()
     assert c.jammed and c.isostatic and c.force_balance < 1e-12 and c.gap_error < 1e-13 and c.overlap <= 1e-14
     assert c.min_force > 0 and rep.n_lps >= 3 and abs(rep.phi_lp - c.phi) < 1e-9 and rep.growth_last < 1e-12
+    assert rep.quench_iterations == 0 and abs(rep.phi_start - 0.45) < 1e-9
+
+
+def test_jam_lp_quench_certified():
+    # the quench start (since 0.2.10): as jam_packing --method quench+lp
+    s = odhs.System(2, 64)
+    s.set_radii_bidisperse(0.5, 1.4, 0.03, 7)
+    s.place_random(0.45, 8)
+    st = odhs.Stepper(s, odhs.Driver(compression_rate=1.0), odhs.Solver("dense"))
+    with pytest.raises(odhs.InvalidError):
+        st.jam_lp(quench=True, quench_phi=1.5)
+    try:
+        status, rep = st.jam_lp(quench=True)
+    except odhs.NotInstalledError:
+        pytest.skip("libodhs built without CLP")
+    assert status == odhs.Status.JAMMED
+    c = st.certificate()
+    assert c.jammed and c.isostatic and c.force_balance < 1e-12 and c.gap_error < 1e-13 and c.overlap <= 1e-14
+    assert c.min_force > 0 and rep.quench_iterations > 0 and 0.7 < rep.phi_start < 0.86 and rep.phi_start < c.phi
