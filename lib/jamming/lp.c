@@ -82,9 +82,11 @@ static int lp_settings(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_ja
                            "jam_lp options: trust %g is more than half a mean diameter per programme", o->trust);
     if (o->quench != 0 && o->quench != 1)
         return odhs__sterr(st, ODHS_E_INVALID, "jam_lp options: quench = %d (0: no quench, 1: quench start)", o->quench);
-    if (!isfinite(o->quench_phi) || o->quench_phi < 0.0 || o->quench_phi >= 1.0)
-        return odhs__sterr(st, o->quench_phi != o->quench_phi || isinf(o->quench_phi) ? ODHS_E_NONFINITE : ODHS_E_INVALID,
-                           "jam_lp options: quench_phi = %g must be in (0, 1) (0: default)", o->quench_phi);
+    if (!isfinite(o->quench_phi))
+        return odhs__sterr(st, ODHS_E_NONFINITE, "jam_lp options: quench_phi must be finite");
+    if (o->quench_phi < 0.0 || o->quench_phi >= 1.0)
+        return odhs__sterr(st, ODHS_E_INVALID, "jam_lp options: quench_phi = %g must be in (0, 1) (0: default)",
+                           o->quench_phi);
     if (o->quench_phi == 0.0) o->quench_phi = st->dim == 2 ? LP_QUENCH_PHI_2D : LP_QUENCH_PHI_3D;
     if (o->trust == 0.0) o->trust = LP_TRUST;
     if (o->tol == 0.0) o->tol = LP_TOL;

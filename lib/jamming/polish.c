@@ -62,7 +62,7 @@ int odhs__jam_polish(odhs_system *sys, odhs_network *net, odhs_solver *sol, cons
             fg2 += f0[c] * net->gap[c];
         }
         for (size_t c = 0, q = 0; c < nc; ++c)
-            if (c != k) gap[q++] = net->gap[c] - f0[c] * fg2 / ff;
+            if (c != k) gap[q++] = net->gap[c] - (ff > 0.0 ? f0[c] * fg2 / ff : 0.0);
         memset(y, 0, nc * sizeof *y);
         st = odhs_solver_solve(sol, sub, gap, y);
         odhs__free(gap);
