@@ -132,8 +132,9 @@ typedef struct odhs_jam_lp_report {
  * final pivots of a compression run.
  *
  * The chain ends with contact gaps up to the LP solver's tolerance; when
- * the end game's polish leaves gaps above 1e-14 (relative), the end game
- * runs again on the packing, at most twice (report.polishes).
+ * the end game's polish leaves gaps above 5e-14 (relative; 1e-14 up to
+ * 0.2.9, below the round-off of large packings), the end game runs again
+ * on the packing, at most twice (report.polishes).
  *
  * The quench start (opt.quench = 1; since 0.2.10) is much faster near and
  * at large N: the start is compressed affinely to quench_phi and its soft

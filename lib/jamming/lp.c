@@ -51,7 +51,7 @@
 #define LP_FEAS 1e-10       /* CLP's primal and dual feasibility tolerances */
 #define LP_SHAKES 3         /* shakes of a degenerate packing at most */
 #define LP_MIN_FORCE 1e-9   /* a backbone force below this (relative to the mean) is degenerate */
-#define LP_GAP 1e-14        /* contact gaps (relative) above this get another polish ... */
+#define LP_GAP 5e-14        /* contact gaps (relative) above this get another polish ... */
 #define LP_POLISHES 2       /* ... at most this many */
 #define LP_QUENCH_PHI_2D 0.86 /* default packing fraction of the quench start, 2D */
 #define LP_QUENCH_PHI_3D 0.66 /* ... and 3D */
@@ -511,9 +511,11 @@ int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_j
             goto done;
         }
         /* the chain ends with contact gaps up to CLP's feasibility tolerance,
-         * which one polish brings to ~1e-13 at N = 4096: polish again (the
-         * end game once more: polish, f0, pivots, rattlers, f0 check); a
-         * failed polish is undone */
+         * which one polish normally brings to round-off (1.5e-14 at 2D
+         * N = 4096, the floor of its coordinates; LP_GAP is above it): a
+         * packing left above LP_GAP is polished again (the end game once
+         * more: polish, f0, pivots, rattlers, f0 check); a failed polish is
+         * undone */
         for (int k = 0; k < LP_POLISHES && c.gap_error > LP_GAP; ++k) {
             const uint64_t piv0 = st->njam_pivots;
             if ((e = odhs__st_save(st))) break;
