@@ -78,8 +78,8 @@ static int jam_lp(odhs_stepper *st, double trust, int quench, double quench_phi,
     odhs_jam_lp_report r = {.size = sizeof r};
     int rc = odhs_stepper_jam_lp(st, &o, &r);
     if (!quiet && rc == ODHS_JAMMED && quench)
-        fprintf(stderr, "jam_packing: quench: %llu FIRE iterations; the chain started at phi = %.6f\n",
-                (unsigned long long)r.quench_iterations, r.phi_start);
+        fprintf(stderr, "jam_packing: quench: %llu FIRE iterations, %zu rescalings; the chain started at phi = %.6f\n",
+                (unsigned long long)r.quench_iterations, r.quench_steps, r.phi_start);
     if (!quiet && rc == ODHS_JAMMED)
         fprintf(stderr,
                 "jam_packing: %zu linear programmes (%llu simplex iterations, at most %zu pairs), phi = %.12f; "

@@ -16,6 +16,9 @@ int odhs__stepper_set_rewire_mode(odhs_stepper *st, int mode);
 /* tests: the smallest backbone force (relative to the mean) below which
  * odhs_stepper_jam_lp shakes a packing (lib/jamming/lp.c; 0: its default) */
 void odhs__stepper_set_lp_min_force(odhs_stepper *st, double v);
+/* tests: 1 = jam_lp solves a programme without a basis by the dual simplex
+ * from the slack basis (up to 0.2.10) instead of the primal values pass */
+void odhs__stepper_set_lp_cold_dual(odhs_stepper *st, int v);
 
 /* ---- stepper ------------------------------------------------------------------ */
 typedef struct {
@@ -79,6 +82,8 @@ struct odhs_stepper {
     uint64_t nrewire_monotone;  /* rewirings the anti-cycling method finished (not checkpointed) */
     uint64_t njam_pivots;       /* pivots of jam_finish on the final packing (not checkpointed) */
     double lp_min_force;        /* tests: jam_lp's degeneracy threshold (0: default; lp.c) */
+    int lp_cold_dual;           /* tests: jam_lp solves a programme without a basis by the dual
+                                 * simplex from the slack basis, as up to 0.2.10 (lp.c) */
     /* fixed pressure through the network without contact iso_k (pressure.c):
      * scratch vectors in fpj (f0 and freg first, nc each); pj_bordered while
      * the velocities are S^T freg + pj_alpha pj_res (res: nd, then nd of

@@ -50,12 +50,14 @@ or the contact distance (force_balance, gap_error, overlap, min_force), n_pivots
 
 JamLpReport = collections.namedtuple(
     "JamLpReport",
-    "n_lps simplex_iterations rows_max phi_lp growth_last end_steps shakes polishes quench_iterations phi_start")
+    "n_lps simplex_iterations rows_max phi_lp growth_last end_steps shakes polishes quench_iterations phi_start "
+    "quench_steps")
 JamLpReport.__doc__ = """What Stepper.jam_lp did (odhs_jam_lp_report, jamming.h): the linear programmes solved,
-their dual simplex iterations, the largest number of pair constraints, phi at the end of the chain,
+their simplex iterations, the largest number of pair constraints, phi at the end of the chain,
 sqrt(Gamma) - 1 of the last programme, the event-driven steps of the end game, the degenerate
 packings shaken and jammed again, the extra polishes of the contact gaps, the FIRE iterations of the
-quench start (0 without it), and phi where the chain started."""
+quench start (0 without it), phi where the chain started, and the rescalings of the quench toward
+phi_J (since 0.2.11)."""
 
 Propulsion = collections.namedtuple("Propulsion", "forces switch_times")
 Propulsion.__doc__ = """Current self-propulsion forces (n, dim) and next switch times (n,), or None

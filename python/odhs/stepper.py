@@ -626,8 +626,8 @@ class Stepper(Owned):
         end game certifies it. The driver must compress and do nothing else. Options left 0
         take the library's defaults (trust region 0.1 mean diameters, tol 1e-12). quench=True
         (since 0.2.10) starts the chain from a soft-sphere quench to quench_phi (default 0.86
-        in 2D, 0.66 in 3D), dilated until no pair overlaps: the fastest route, a quench
-        protocol. Returns (status, JamLpReport); status is Status.JAMMED when the packing is
+        in 2D, 0.66 in 3D), brought toward phi_J by rescalings of its mean overlap (since
+        0.2.11) and dilated until no pair overlaps: the fastest route, a quench protocol. Returns (status, JamLpReport); status is Status.JAMMED when the packing is
         made."""
         o = ffi.new("odhs_jam_lp_options *")
         o.size = ffi.sizeof("odhs_jam_lp_options")
@@ -643,7 +643,7 @@ class Stepper(Owned):
         st = self._run_result(rc, "Stepper.jam_lp")
         return st, JamLpReport(int(r.n_lps), int(r.simplex_iterations), int(r.rows_max), r.phi_lp, r.growth_last,
                                int(r.end_steps), int(r.shakes), int(r.polishes), int(r.quench_iterations),
-                               r.phi_start)
+                               r.phi_start, int(r.quench_steps))
 
     # --- files -------------------------------------------------------------------------------
     def write_checkpoint(self, path):

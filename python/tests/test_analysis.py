@@ -139,7 +139,7 @@ def test_jam_lp_certified():
     c = st.certificate()
     assert c.jammed and c.isostatic and c.force_balance < 1e-12 and c.gap_error < 1e-13 and c.overlap <= 1e-14
     assert c.min_force > 0 and rep.n_lps >= 3 and abs(rep.phi_lp - c.phi) < 1e-9 and rep.growth_last < 1e-12
-    assert rep.quench_iterations == 0 and abs(rep.phi_start - 0.45) < 1e-9
+    assert rep.quench_iterations == 0 and rep.quench_steps == 0 and abs(rep.phi_start - 0.45) < 1e-9
 
 
 def test_jam_lp_quench_certified():
@@ -158,3 +158,5 @@ def test_jam_lp_quench_certified():
     c = st.certificate()
     assert c.jammed and c.isostatic and c.force_balance < 1e-12 and c.gap_error < 1e-13 and c.overlap <= 1e-14
     assert c.min_force > 0 and rep.quench_iterations > 0 and 0.7 < rep.phi_start < 0.86 and rep.phi_start < c.phi
+    # since 0.2.11 the quench is rescaled toward phi_J before the chain starts
+    assert 1 <= rep.quench_steps <= 4 and rep.phi_start > c.phi - 0.01
