@@ -154,7 +154,7 @@ typedef struct odhs_jam_lp_report {
  * below jamming needs hundreds, each also cheaper (measured in
  * docs/jamming.md: 3D N = 1000 in about 10 CPU s against 3 CPU min). It is the
  * protocol of an infinitely fast quench, not a compression: its packings
- * are denser (2D N = 256, the same 12 starts: phi_J = 0.8432 +- 0.0016
+ * are denser (2D N = 256, the same 12 starts: phi_J = 0.8434 +- 0.0016
  * against 0.8377 +- 0.0031 for the event-driven compression at rate 1,
  * standard deviations).
  *

@@ -342,15 +342,14 @@ static void lp_apply(odhs_stepper *st, lp_work *w, double g)
 }
 
 /* The quench start on a copy of the system: affine compression to
- * o->quench_phi, FIRE on the harmonic soft-sphere energy, and a dilation
- * until no pair overlaps (w->xq, w->Lq). */
+ * o->quench_phi, FIRE on the harmonic soft-sphere energy, rescalings toward
+ * phi_J, and a dilation until no pair overlaps (w->xq, w->Lq). */
 typedef struct {
     const double *r;
     double f;     /* the largest sigma / |r_ij| */
     double sum;   /* the sum of the relative overlaps 1 - |r_ij| / sigma ... */
     size_t count; /* ... over this many overlapping pairs */
 } lp_dilate_ctx;
-
 
 static int lp_dilate_cb(size_t i, size_t j, const double *rij, double gap, void *vctx)
 {
@@ -387,7 +386,8 @@ static int lp_quench(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w,
     for (int k = 0;; ++k) {
         uint64_t it = 0;
         s = odhs_softcore_minimise(sc, &it);
-        if (s == ODHS_E_NOCONV) s = ODHS_OK, it = LP_QUENCH_ITER; /* used as it is (rolled back: the start of this relaxation) */
+        /* unfinished: used as it is (rolled back to the start of this relaxation) */
+        if (s == ODHS_E_NOCONV) s = ODHS_OK, it = LP_QUENCH_ITER;
         if (s) goto fail;
         rep->quench_iterations += it;
         c.f = 1.0;

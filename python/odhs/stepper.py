@@ -627,8 +627,8 @@ class Stepper(Owned):
         take the library's defaults (trust region 0.1 mean diameters, tol 1e-12). quench=True
         (since 0.2.10) starts the chain from a soft-sphere quench to quench_phi (default 0.86
         in 2D, 0.66 in 3D), brought toward phi_J by rescalings of its mean overlap (since
-        0.2.11) and dilated until no pair overlaps: the fastest route, a quench protocol. Returns (status, JamLpReport); status is Status.JAMMED when the packing is
-        made."""
+        0.2.11) and dilated until no pair overlaps: the fastest route, a quench protocol.
+        Returns (status, JamLpReport); status is Status.JAMMED when the packing is made."""
         o = ffi.new("odhs_jam_lp_options *")
         o.size = ffi.sizeof("odhs_jam_lp_options")
         o.trust = float(trust)
