@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "odhs.h"
+#include "geom/geom.h" /* odhs__remap_strain */
 
 static char dir[64];
 
@@ -575,6 +576,155 @@ START_TEST(test_sections_round_trip)
 }
 END_TEST
 
+/* the stepper's velocity gradient G and cell matrix M have the shapes the
+ * stepper makes: a file with a foreign entry is refused (fuzz_checkpoint: a
+ * 2D file with G_xz = -8e298 stepped into a NaN cell matrix, which the writer
+ * then saved and the reader refused); a huge shear entry of M is a valid
+ * shape: the neighbour list is rebuilt and the run goes on */
+static double rdf(const unsigned char *p)
+{
+    uint64_t v = rd64(p);
+    double x;
+    memcpy(&x, &v, sizeof x);
+    return x;
+}
+
+static void wrf(unsigned char *p, double x)
+{
+    uint64_t v;
+    memcpy(&v, &x, sizeof v);
+    wr64(p, v);
+}
+
+START_TEST(test_stepper_shapes)
+{
+    size_t len;
+    odhs_solver *sol;
+    unsigned char *buf = make_ckpt(&len, &sol); /* 2D, N = 16, shear rate 1 */
+    const size_t nd = 32, stp = last_tag(buf, last_tag(buf, len, "NET "), "STP ");
+    const size_t g = stp + 4 + 15 * 8, m = g + 9 * 8 + 8 + 8 + nd * 8 + 8 + 8 + nd * 8;
+    /* the layout: G_xy is the shear rate, M_zz = 1 in 2D, M_xx = M_yy = 1 */
+    ck_assert_double_eq(rdf(buf + g + 8), 1.0);
+    ck_assert_double_eq(rdf(buf + m + 8 * 8), 1.0);
+    ck_assert_double_eq(rdf(buf + m), 1.0);
+    ck_assert_double_eq(rdf(buf + m + 4 * 8), 1.0);
+    unsigned char *alt = malloc(len);
+    odhs_system *s;
+    odhs_driver *d;
+    odhs_stepper *st;
+    char err[256];
+    static const struct {
+        int in_m, k;
+        double v;
+        const char *what;
+    } bad[] = {
+        {0, 2, -8e298, "velocity gradient"}, {0, 3, 8e-317, "velocity gradient"},
+        {0, 4, -0.5, "velocity gradient"},   {0, 8, -0.5, "velocity gradient"},
+        {1, 6, 4e-310, "cell matrix"},       {1, 4, 0.99, "cell matrix"},
+        {1, 8, 0.99, "cell matrix"},         {1, 3, 1e-3, "cell matrix"},
+    };
+    for (size_t c = 0; c < sizeof bad / sizeof bad[0]; ++c) {
+        memcpy(alt, buf, len);
+        wrf(alt + (bad[c].in_m ? m : g) + 8 * (size_t)bad[c].k, bad[c].v);
+        wr64(alt + len - 8, fnv1a(alt, len - 8));
+        int rc = odhs_checkpoint_parse(alt, len, sol, &s, &d, &st, err, sizeof err);
+        ck_assert_msg(rc == ODHS_E_FORMAT, "case %zu accepted (%d)", c, rc);
+        ck_assert_msg(strstr(err, bad[c].what) != NULL, "case %zu: %s", c, err);
+        ck_assert(s == NULL && d == NULL && st == NULL);
+    }
+    /* a negative scale of the cell (both diagonal entries) */
+    memcpy(alt, buf, len);
+    wrf(alt + m, -1.0);
+    wrf(alt + m + 4 * 8, -1.0);
+    wr64(alt + len - 8, fnv1a(alt, len - 8));
+    ck_assert_int_eq(odhs_checkpoint_parse(alt, len, sol, &s, &d, &st, err, sizeof err), ODHS_E_FORMAT);
+    ck_assert(strstr(err, "not positive") != NULL);
+    /* a compressing cell (equal diagonal) and a huge shear entry: valid; the
+     * steps rebuild the list, and what they leave is written and read back */
+    memcpy(alt, buf, len);
+    wrf(alt + m, 0.975);
+    wrf(alt + m + 4 * 8, 0.975);
+    wrf(alt + m + 8, 1.7e147);
+    wr64(alt + len - 8, fnv1a(alt, len - 8));
+    ck_assert_int_eq(odhs_checkpoint_parse(alt, len, sol, &s, &d, &st, err, sizeof err), ODHS_OK);
+    for (int k = 0; k < 3; ++k) ck_assert_int_eq(odhs_stepper_step(st, NULL), ODHS_OK);
+    char path[128];
+    snprintf(path, sizeof path, "%s/shapes.ckpt", dir);
+    ck_assert_int_eq(odhs_checkpoint_write(st, path), ODHS_OK);
+    odhs_system *s2;
+    odhs_driver *d2;
+    odhs_stepper *st2;
+    ck_assert_int_eq(odhs_checkpoint_read(path, sol, &s2, &d2, &st2, err, sizeof err), ODHS_OK);
+    odhs_stepper_destroy(st2);
+    odhs_driver_destroy(d2);
+    odhs_system_destroy(s2);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(d);
+    odhs_system_destroy(s);
+    free(alt);
+    free(buf);
+    odhs_solver_destroy(sol);
+}
+END_TEST
+
+/* a box of aspect ratio 6.8e-79 sheared: the strain, 1e-4 after the first
+ * steps, is gamma / (Lx/Ly) = 1e74 periods of the Lees-Edwards lattice; the
+ * remap cancelled to a multiple of ulp(gamma) far outside [-Lx/2Ly, Lx/2Ly],
+ * and the checkpoint written then could not be read back (fuzz_checkpoint,
+ * 0.2.12) */
+START_TEST(test_remap_extreme_aspect)
+{
+    const size_t n = 12;
+    const double L[2] = {4.91, 7.25e78};
+    double x[24], r[12];
+    for (size_t i = 0; i < n; ++i) {
+        x[2 * i] = 0.1 + 0.4 * (double)i;
+        x[2 * i + 1] = 1.0 + 2.0 * (double)i;
+        r[i] = 0.1;
+    }
+    odhs_system *sys;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    ck_assert_int_eq(odhs_system_create(2, n, &sys), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_box(sys, L), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_radii(sys, r), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_positions(sys, x), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+    double strain = 0.0, g = 0.0;
+    /* the old remap failed for 141 of 1000 strains 1e-4 (1 + k 1e-3) on this
+     * box: checked directly, and along 40 steps */
+    size_t bad = 0;
+    for (int k = 0; k < 1000; ++k) bad += !(fabs(odhs__remap_strain(1e-4 * (1 + k * 1e-3), L)) <= 0.5 * L[0] / L[1]);
+    ck_assert_uint_eq(bad, 0);
+    for (int k = 0; k < 40; ++k) {
+        ck_assert_int_eq(odhs_stepper_step(st, NULL), ODHS_OK);
+        ck_assert_int_eq(odhs_system_get_strain(sys, &g), ODHS_OK);
+        ck_assert_msg(fabs(g) <= 0.5 * L[0] / L[1], "step %d: remapped strain %g outside +-%g", k, g,
+                      0.5 * L[0] / L[1]);
+    }
+    ck_assert_int_eq(odhs_stepper_strain(st, &strain), ODHS_OK);
+    ck_assert(strain > 1e-6);
+    char path[128], err[256];
+    snprintf(path, sizeof path, "%s/aspect.ckpt", dir);
+    ck_assert_int_eq(odhs_checkpoint_write(st, path), ODHS_OK);
+    odhs_system *s2;
+    odhs_driver *d2;
+    odhs_stepper *st2;
+    ck_assert_msg(odhs_checkpoint_read(path, sol, &s2, &d2, &st2, err, sizeof err) == ODHS_OK, "%s", err);
+    odhs_stepper_destroy(st2);
+    odhs_driver_destroy(d2);
+    odhs_system_destroy(s2);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+    odhs_solver_destroy(sol);
+}
+END_TEST
+
 Suite *make_checkpoint_suite(void)
 {
     Suite *s = suite_create("checkpoint");
@@ -594,6 +744,8 @@ Suite *make_checkpoint_suite(void)
     tcase_add_test(tc, test_truncated_and_corrupted);
     tcase_add_test(tc, test_atomic_write);
     tcase_add_test(tc, test_sections_round_trip);
+    tcase_add_test(tc, test_stepper_shapes);
+    tcase_add_test(tc, test_remap_extreme_aspect);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -1230,6 +1230,40 @@ START_TEST(test_quench_rescaled)
 }
 END_TEST
 
+/* The last programme's active pairs are the reset's contacts (0.2.12): a
+ * chain stopped at tol = 1e-8 leaves them with gaps of up to ~1e-8 contact
+ * distances, above the reset's contact tolerance 1e-9; without them the
+ * reset was hypostatic and the end game stepped (3D N = 343, seed 1: 55
+ * event-driven steps; 3D N = 1000, seed 1, tol = 1e-9: 1368 steps and 31
+ * CPU s against 9.4). With them it is jammed at the reset, and the packing
+ * is the one of the default chain (tol 1e-12). */
+START_TEST(test_lp_active_contacts)
+{
+    double phi[2];
+    size_t nc[2];
+    for (int v = 0; v < 2; ++v) {
+        jrun r;
+        jrun_start(&r, 3, 343, 1, "compress", "default");
+        jrun_configure(&r);
+        odhs_jam_lp_options o = {.size = sizeof o, .quench = 1, .tol = v == 0 ? 1e-8 : 0.0};
+        odhs_jam_lp_report rep = {.size = sizeof rep};
+        r.rc = odhs_stepper_jam_lp(r.st, &o, &rep);
+        char msg[768] = "";
+        ck_assert_msg(r.rc == ODHS_JAMMED && independent_check(&r, msg, sizeof msg), "tol %g: status %d: %s %s",
+                      o.tol, r.rc, odhs_stepper_errmsg(r.st), msg);
+        ck_assert_msg(rep.end_steps == 0, "tol %g: %llu event-driven steps after %zu programmes", o.tol,
+                      (unsigned long long)rep.end_steps, rep.n_lps);
+        odhs_jam_certificate c = {.size = sizeof c};
+        CHECK_OK(odhs_stepper_certificate(r.st, &c));
+        phi[v] = c.phi;
+        nc[v] = c.n_contacts;
+        jrun_free(&r);
+    }
+    ck_assert_msg(fabs(phi[0] - phi[1]) < 1e-10 && nc[0] == nc[1], "tol 1e-8: phi %.15f, %zu contacts; default: %.15f, %zu",
+                  phi[0], nc[0], phi[1], nc[1]);
+}
+END_TEST
+
 /* A programme without a basis to start from (the first of a chain) is
  * solved by the primal simplex from the feasible point s = 0 (0.2.11).
  * From the quench start it needs fewer pivots than the dual simplex from
@@ -2672,6 +2706,7 @@ Suite *make_jamming_suite(void)
     tcase_add_test(tc, test_quench_report);
     tcase_add_loop_test(tc, test_quench_rescaled, 0, 4);
     tcase_add_loop_test(tc, test_lp_primal_start, 0, 3);
+    tcase_add_test(tc, test_lp_active_contacts);
     tcase_add_loop_test(tc, test_quench_polish, 0, 3);
     tcase_add_test(tc, test_quench_refined_f0);
     tcase_add_test(tc, test_lp_shake);

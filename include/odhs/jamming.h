@@ -131,9 +131,13 @@ typedef struct odhs_jam_lp_report {
  * shrinks by the growth the real pairs allow. At the end (sqrt(Gamma) - 1 <
  * tol) the programme's active pairs are the jammed network: the stepper is
  * reset on the configuration, takes the touching pairs (its contact
- * tolerance) as its network, and steps under the compression until
- * ODHS_JAMMED (normally at once), with the rewiring, self-stress, polish and
- * final pivots of a compression run.
+ * tolerance) and, since 0.2.12, the last programme's active pairs with a gap
+ * below 1e-6 of their contact distance as its network, and steps under the
+ * compression until ODHS_JAMMED (normally at once), with the rewiring,
+ * self-stress, polish and final pivots of a compression run. (The active
+ * pairs' gaps are second order in the last displacements, up to about 1e-8
+ * at 3D N = 8000, above the contact tolerance of 1e-9: without them the
+ * network could be short of contacts and the end game stepped.)
  *
  * The chain ends with contact gaps up to the LP solver's tolerance; when
  * the end game's polish leaves gaps above 5e-14 (relative; 1e-14 up to

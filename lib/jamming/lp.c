@@ -161,7 +161,8 @@ typedef struct {
     double *xq, Lq[3]; /* the quench start (NULL: none) */
     unsigned char *status;
     lp_basis *basis;
-    size_t nbasis, cap_start, cap_row, cap_val, cap_rlo, cap_rup, cap_status, cap_basis;
+    size_t *added; /* pairs of the last programme made contacts before the reset */
+    size_t nbasis, cap_start, cap_row, cap_val, cap_rlo, cap_rup, cap_status, cap_basis, cap_added, nadded;
     double smin; /* the smallest diameter */
     int shake;   /* the chain's shake (0: the first chain) */
 } lp_work;
@@ -183,6 +184,7 @@ static void lp_free(lp_work *w)
     odhs__free(w->s);
     odhs__free(w->status);
     odhs__free(w->basis);
+    odhs__free(w->added);
     odhs__free(w->xq);
 }
 
@@ -479,6 +481,43 @@ static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, 
     return ODHS_OK;
 }
 
+/* The last programme's active pairs (rows at their bound) are the contacts
+ * of the chain's vertex. Their gaps are second order in that programme's
+ * displacements (3D N = 8000: up to 2.8e-5 diameters, gaps up to about
+ * 1e-8), above the reset's contact tolerance (1e-9), so the reset alone
+ * can miss some and start the end game hypostatic (it then steps: 55
+ * event-driven steps at 3D N = 343 with tol = 1e-8). Made temporary
+ * contacts here, the reset keeps those within its keep distance (1e-6 of
+ * the contact distance) and the polish closes them. w->added lists them
+ * (pair indices), for lp_unmark_active after a failed reset. */
+static int lp_mark_active(odhs_stepper *st, lp_work *w)
+{
+    const size_t nc = st->nd + 1, m = w->pr.m;
+    w->nadded = 0;
+    if (odhs__reserve((void **)&w->added, &w->cap_added, m + 1, sizeof *w->added))
+        return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+    for (size_t q = 0; q < m; ++q) {
+        if ((w->status[nc + q] & 7) == 1) continue; /* basic: the pair is not tight */
+        size_t i = w->pr.i[q], j = w->pr.j[q];
+        if (i == j || odhs__net_find(st->net, i < j ? i : j, i < j ? j : i) != SIZE_MAX) continue;
+        if (odhs__net_add(st->net, i, j, ODHS_CONTACT_TEMPORARY) == SIZE_MAX)
+            return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
+        w->added[w->nadded++] = q;
+    }
+    return ODHS_OK;
+}
+
+/* undo lp_mark_active (the reset failed and the stepper is put back) */
+static void lp_unmark_active(odhs_stepper *st, lp_work *w)
+{
+    for (size_t k = 0; k < w->nadded; ++k) {
+        size_t q = w->added[k], i = w->pr.i[q], j = w->pr.j[q];
+        size_t c = odhs__net_find(st->net, i < j ? i : j, i < j ? j : i);
+        if (c != SIZE_MAX && st->net->kind[c] == ODHS_CONTACT_TEMPORARY) odhs__net_remove_at(st->net, c);
+    }
+    w->nadded = 0;
+}
+
 #endif /* ODHS_HAVE_CLP */
 
 void odhs__stepper_set_lp_min_force(odhs_stepper *st, double v)
@@ -529,11 +568,12 @@ int odhs_stepper_jam_lp(odhs_stepper *st, const odhs_jam_lp_options *opt, odhs_j
         memcpy(sys->x, w.xc, st->nd * sizeof *w.xc);
         memcpy(sys->L, w.Lc, sizeof w.Lc);
         const int pre0 = st->pre_state, jammed0 = st->jammed;
-        if ((s = odhs_stepper_reset(st))) {
+        if ((s = lp_mark_active(st, &w)) || (s = odhs_stepper_reset(st))) {
             char msg[ODHS_ERRMSG_LEN];
             memcpy(msg, st->errmsg, sizeof msg);
             memcpy(sys->x, x0, st->nd * sizeof *x0);
             memcpy(sys->L, L0, sizeof L0);
+            lp_unmark_active(st, &w);
             odhs__net_geometry(st->net, sys); /* the gaps and normals of the start */
             st->ready = 1;
             st->jammed = jammed0;

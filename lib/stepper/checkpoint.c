@@ -58,6 +58,22 @@ static int check_stepper(odhs__ckpt_in *in, const odhs_stepper *st)
                               : !odhs__finite_all(st->M, 9)  ? "cell matrix"
                               : !odhs__finite_all(st->U, nd) ? "velocities"
                                                              : "displacements");
+    /* the shapes the stepper makes (odhs__flow_gradient, odhs__st_advance):
+     * G = gdot e_x e_y^T - c (I on the dim axes), and the cell matrix a
+     * product of (I + t G), so m (I on the dim axes) + b e_x e_y^T, with
+     * m > 0 and 1 on an unused third axis. A file with anything else would
+     * step with it (a 2D file with G_xz = -8e298: fuzz_checkpoint). */
+    const int dim = st->dim;
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) {
+            const int k = 3 * a + c, diag = a == c && a < dim;
+            if (a == 0 && c == 1) continue;
+            if ((diag && (st->G[k] != st->G[0] || st->M[k] != st->M[0])) || (!diag && st->G[k] != 0.0) ||
+                (!diag && st->M[k] != (a == c ? 1.0 : 0.0)))
+                return odhs__ckpt_bad(in, "checkpoint: the stepper's %s has a foreign entry (%d,%d)",
+                                      st->G[k] != (diag ? st->G[0] : 0.0) ? "velocity gradient" : "cell matrix", a, c);
+        }
+    if (!(st->M[0] > 0.0)) return odhs__ckpt_bad(in, "checkpoint: the stepper's cell matrix is not positive");
     if (!(st->dt > 0) || !(st->tol > 0 && st->tol < 1) || !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) ||
         !(st->skin > 0) || st->contact_tol < 0)
         return odhs__ckpt_bad(

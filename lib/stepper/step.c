@@ -66,7 +66,8 @@ static int driver_update(odhs_stepper *st, step_undo *u, odhs_event *first, int 
 static int fit_neighbours(odhs_stepper *st, odhs__step_plan *p)
 {
     double rate = odhs__st_skin_rate(st, p->G, p->vel);
-    if (!st->nb_stale && !(odhs__st_skin_used(st) + rate * p->tplan > st->skin)) return ODHS_OK;
+    const double used = odhs__st_skin_used(st); /* a non-finite one rebuilds */
+    if (!st->nb_stale && isfinite(used) && !(used + rate * p->tplan > st->skin)) return ODHS_OK;
     st->nb_stale = 0;
     int s = odhs__st_build_neighbours(st);
     if (s) return s;
