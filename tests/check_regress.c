@@ -29,7 +29,8 @@
  * it picks for the CPU (OpenBLAS uses its SkylakeX kernels on Intel AVX-512
  * and its Haswell/Zen ones on AMD EPYC: the scenes then differ in the last
  * bits). Recording also writes regress/blas.txt, a fingerprint of the
- * rounding of a fixed set of LAPACK calls (blas_fingerprint). When the
+ * rounding of a fixed set of LAPACK calls (blas_fingerprint), and refuses to
+ * add scenes to a corpus recorded with another fingerprint. When the
  * fingerprint now differs from the recorded one, every scene is compared in
  * the "other BLAS" mode, announced on stderr: numeric tokens agree when
  * |a - b| <= OTHER_REL max(|a|, |b|) + OTHER_ABS max(1, largest |number| of
@@ -1121,7 +1122,7 @@ static const scene_entry scenes[] = {
 #define NSCENES ((int)(sizeof scenes / sizeof scenes[0]))
 
 /* ---- comparison ------------------------------------------------------------------ */
-static int is_number_tok(const char *tok, double *v)
+static int is_number(const char *tok, double *v)
 {
     char *end;
     errno = 0;
@@ -1178,7 +1179,7 @@ static double line_scale(const char *l)
     char *c = strdup(l), *sp;
     ck_assert(c != NULL);
     for (char *t = strtok_r(c, " ", &sp); t; t = strtok_r(NULL, " ", &sp))
-        if (is_number_tok(t, &v) && isfinite(v)) m = fmax(m, fabs(v));
+        if (is_number(t, &v) && isfinite(v)) m = fmax(m, fabs(v));
     free(c);
     return m;
 }
@@ -1213,7 +1214,7 @@ static int lines_match(const char *a, const char *b, double rel_tol, int other)
             break;
         }
         double x, y;
-        if (is_number_tok(ta, &x) && is_number_tok(tb, &y)) {
+        if (is_number(ta, &x) && is_number(tb, &y)) {
             double m = fmax(fabs(x), fabs(y));
             eq = (isnan(x) && isnan(y)) || x == y || fabs(x - y) <= fmax(rel * m, abs_tol);
         } else {
@@ -1343,10 +1344,20 @@ START_TEST(test_scene)
         ck_assert_msg(f != NULL, "cannot write %s: %s", path, strerror(errno));
         ck_assert(fwrite(T, 1, T_len, f) == T_len);
         ck_assert(fclose(f) == 0);
+        /* one corpus, one BLAS: scenes of another BLAS are not mixed in */
         snprintf(path, sizeof path, "%s/blas.txt", rec);
+        size_t len;
+        char *old = read_file(path, &len);
+        uint64_t now = blas_fingerprint(), was = 0;
+        int mixed = old && !(sscanf(old, "blas %" SCNx64, &was) == 1 && was == now);
+        free(old);
+        ck_assert_msg(!mixed,
+                      "regress: %s holds another BLAS fingerprint (%016" PRIx64 ", now %016" PRIx64
+                      "): delete it to re-record the whole corpus",
+                      path, was, now);
         f = fopen(path, "wb");
         ck_assert_msg(f != NULL, "cannot write %s: %s", path, strerror(errno));
-        ck_assert(fprintf(f, "blas %016" PRIx64 "\n", blas_fingerprint()) > 0);
+        ck_assert(fprintf(f, "blas %016" PRIx64 "\n", now) > 0);
         ck_assert(fclose(f) == 0);
     } else {
         const char *dir = getenv("ODHS_TEST_DATA");

@@ -14,18 +14,14 @@ static inline double odhs__remap_strain(double gamma, const double *L)
 {
     double u = L[0] / L[1];
     double g = gamma - nearbyint(gamma / u) * u;
+    /* gamma / u beyond 2^53 (a box of aspect ratio 1e-78 sheared by 5e-23:
+     * fuzz_checkpoint): the product above cancels to a multiple of ulp(gamma)
+     * far outside the range. fmod is exact, and so is the shift by u after
+     * it; only then, so that every other remap stays bit for bit. */
+    if (!(fabs(g) <= u)) g = fmod(gamma, u);
     /* rounding can leave |g| a hair above u/2 */
     if (g > 0.5 * u) g -= u;
     else if (g < -0.5 * u) g += u;
-    /* gamma / u beyond 2^53 (a box of aspect ratio 1e-78 sheared by 5e-23:
-     * fuzz_checkpoint): the product above cancels to a multiple of ulp(gamma)
-     * far above u. fmod is exact, and so is the shift by u after it. Only
-     * then, so that every other remap stays bit for bit as it was. */
-    if (!(fabs(g) <= 0.5 * u)) {
-        g = fmod(gamma, u);
-        if (g > 0.5 * u) g -= u;
-        else if (g < -0.5 * u) g += u;
-    }
     return g;
 }
 

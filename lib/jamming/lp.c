@@ -490,6 +490,11 @@ static int lp_chain(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w, 
  * contacts here, the reset keeps those within its keep distance (1e-6 of
  * the contact distance) and the polish closes them. w->added lists them
  * (pair indices), for lp_unmark_active after a failed reset. */
+static size_t lp_net_find(const odhs_network *net, size_t i, size_t j)
+{
+    return i < j ? odhs__net_find(net, i, j) : odhs__net_find(net, j, i);
+}
+
 static int lp_mark_active(odhs_stepper *st, lp_work *w)
 {
     const size_t nc = st->nd + 1, m = w->pr.m;
@@ -499,7 +504,7 @@ static int lp_mark_active(odhs_stepper *st, lp_work *w)
     for (size_t q = 0; q < m; ++q) {
         if ((w->status[nc + q] & 7) == 1) continue; /* basic: the pair is not tight */
         size_t i = w->pr.i[q], j = w->pr.j[q];
-        if (i == j || odhs__net_find(st->net, i < j ? i : j, i < j ? j : i) != SIZE_MAX) continue;
+        if (i == j || lp_net_find(st->net, i, j) != SIZE_MAX) continue;
         if (odhs__net_add(st->net, i, j, ODHS_CONTACT_TEMPORARY) == SIZE_MAX)
             return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
         w->added[w->nadded++] = q;
@@ -512,7 +517,7 @@ static void lp_unmark_active(odhs_stepper *st, lp_work *w)
 {
     for (size_t k = 0; k < w->nadded; ++k) {
         size_t q = w->added[k], i = w->pr.i[q], j = w->pr.j[q];
-        size_t c = odhs__net_find(st->net, i < j ? i : j, i < j ? j : i);
+        size_t c = lp_net_find(st->net, i, j);
         if (c != SIZE_MAX && st->net->kind[c] == ODHS_CONTACT_TEMPORARY) odhs__net_remove_at(st->net, c);
     }
     w->nadded = 0;

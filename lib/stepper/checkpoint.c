@@ -67,11 +67,11 @@ static int check_stepper(odhs__ckpt_in *in, const odhs_stepper *st)
     for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c) {
             const int k = 3 * a + c, diag = a == c && a < dim;
-            if (a == 0 && c == 1) continue;
-            if ((diag && (st->G[k] != st->G[0] || st->M[k] != st->M[0])) || (!diag && st->G[k] != 0.0) ||
-                (!diag && st->M[k] != (a == c ? 1.0 : 0.0)))
-                return odhs__ckpt_bad(in, "checkpoint: the stepper's %s has a foreign entry (%d,%d)",
-                                      st->G[k] != (diag ? st->G[0] : 0.0) ? "velocity gradient" : "cell matrix", a, c);
+            if (a == 0 && c == 1) continue; /* the shear entry: any value */
+            const char *bad = st->G[k] != (diag ? st->G[0] : 0.0)               ? "velocity gradient"
+                              : st->M[k] != (diag ? st->M[0] : a == c ? 1.0 : 0.0) ? "cell matrix"
+                                                                                  : NULL;
+            if (bad) return odhs__ckpt_bad(in, "checkpoint: the stepper's %s has a foreign entry (%d,%d)", bad, a, c);
         }
     if (!(st->M[0] > 0.0)) return odhs__ckpt_bad(in, "checkpoint: the stepper's cell matrix is not positive");
     if (!(st->dt > 0) || !(st->tol > 0 && st->tol < 1) || !(st->h > 0) || !(st->tau > 0) || !(st->lambda > 0) ||
