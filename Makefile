@@ -755,7 +755,7 @@ $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/tests/fuzz/fuzz_%.o $(FUZZ_LIB)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -o $@ $< $(FUZZ_LIB) $(ODHS_LIBS)
 
 fuzz-ci: fuzz
-	@status=0; \
+	@status=0; failed=; \
 	for name in $(FUZZ_NAMES); do \
 	    run=$(FUZZ_BUILD)/ci/$$name; \
 	    rm -rf $$run; mkdir -p $$run/corpus $$run/artifacts $$run/tmp; \
@@ -770,7 +770,18 @@ fuzz-ci: fuzz
 	    echo "fuzz_$$name: $$result: $${execs:-?} executions, corpus $$(ls $$run/corpus | wc -l) inputs (log: $$run/log.txt)"; \
 	    if [ $$result = FAILED ]; then \
 	        tail -n 80 $$run/log.txt; echo "fuzz_$$name: reproducers:"; ls -l $$run/artifacts; \
+	        failed="$$failed $$name"; \
 	    fi; \
+	done; \
+	for name in $$failed; do \
+	    run=$(FUZZ_BUILD)/ci/$$name; \
+	    echo "fuzz_$$name: first error: $$(grep -m1 -E 'check failed|ERROR: |runtime error|Timeout|out-of-memory' $$run/log.txt)"; \
+	    grep -m1 -A1 'check failed' $$run/log.txt | tail -n 1; \
+	    for f in $$run/artifacts/*; do \
+	        [ -f "$$f" ] && [ $$(wc -c < "$$f") -le 8192 ] || continue; \
+	        echo "fuzz_$$name: reproducer $$(basename $$f), base64 on one line (base64 -d > repro):"; \
+	        base64 -w 0 "$$f"; echo; \
+	    done; \
 	done; \
 	if [ $$status -ne 0 ]; then echo "fuzz-ci: FAILED"; else echo "fuzz-ci: ok ($(words $(FUZZ_NAMES)) targets)"; fi; \
 	exit $$status

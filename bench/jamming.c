@@ -45,7 +45,8 @@
  *     packing (exact contacts, certified). ODHS_BENCH_SOFT_LIMIT (seconds,
  *     default 3600) bounds each of these runs.
  *  4. (not in the default "123") the routes side by side from the same
- *     starts, seeds 1..ODHS_BENCH_ROUTE_SEEDS (default 5), sizes
+ *     starts, ODHS_BENCH_ROUTE_SEEDS seeds (default 5) from seed
+ *     ODHS_BENCH_ROUTE_FIRST_SEED (default 1), sizes
  *     ODHS_BENCH_ROUTE_SIZES (default 2:256,2:1024,3:343,3:1000), routes
  *     ODHS_BENCH_ROUTES (default quench,lp,events,soft,lammps): the fast
  *     route from its quench start and from the configuration
@@ -627,6 +628,8 @@ static int table4(int workers, double limit)
     const char *se = getenv("ODHS_BENCH_ROUTE_SEEDS");
     int seeds = se && atoi(se) > 0 ? atoi(se) : 5;
     if (seeds > 50) seeds = 50;
+    const char *fse = getenv("ODHS_BENCH_ROUTE_FIRST_SEED");
+    int first = fse && atoi(fse) > 0 && atoi(fse) < 100000 ? atoi(fse) : 1;
     const char *re = getenv("ODHS_BENCH_ROUTES");
     int want[R_N] = {1, 1, 1, 1, 1};
     if (re && *re) /* whole names of the comma list */
@@ -645,7 +648,7 @@ static int table4(int workers, double limit)
                 result *r = &runs[nr++];
                 r->dim = sizes[z].dim;
                 r->n = sizes[z].n;
-                r->seed = (unsigned)(q + 1);
+                r->seed = (unsigned)(first + q);
                 r->lp = k == R_LP ? 1 : k == R_QUENCH ? 2 : 0;
                 r->soft = k == R_SOFT;
                 r->lammps = k == R_LAMMPS;
@@ -660,14 +663,14 @@ static int table4(int workers, double limit)
         run_pool(runs + k, e - k, workers, INFINITY, limit, 0);
         k = e - 1;
     }
-    printf("\n## Table 4: routes to a jammed packing side by side, the same %d starts per size (seeds 1-%d)\n"
+    printf("\n## Table 4: routes to a jammed packing side by side, the same %d starts per size (seeds %d-%d)\n"
            "##   quench = odhs_stepper_jam_lp from its quench start (soft-sphere quench to phi 0.86, 3D 0.66, then\n"
            "##   the chain), lp = odhs_stepper_jam_lp (chain of linear programmes + exact end game), events = event-driven\n"
            "##   compression, soft = the library's soft-sphere route (table 3), lammps = LAMMPS (lmp) doing the\n"
            "##   O'Hern protocol from phi 0.70 (3D: 0.50) (harmonic, FIRE to 1e-14, bisection to 1e-6). CPU s per packing;\n"
            "##   ratio = route CPU / CPU of the first route listed. phi_J: certified packings for quench, lp and\n"
            "##   events, the last unjammed phi for the soft routes.\n",
-           seeds, seeds);
+           seeds, first, first + seeds - 1);
     printf("%-3s %6s %-7s %5s %9s %10s %10s %11s %9s %8s %s\n", "d", "N", "route", "runs", "certified", "cpu_s",
            "cpu_max", "phi_J", "phi_sd", "ratio", "work");
     for (int z = 0; z < ns; ++z) {

@@ -200,8 +200,8 @@ START_TEST(test_params)
 {
     odhs_solver *a = au_solver("auto");
     const char *bad[] = {"dense_max", "lsq_rcond", "lsq_rcond", "prefer", "retry_after", "check_tol", "suitesparse",
-                         "no-such-param"};
-    const double val[] = {-2.0, 0.0, 1.0, 0.5, -1.0, 0.0, 2.0, 1.0};
+                         "no-such-param", "retry_after_lsq"};
+    const double val[] = {-2.0, 0.0, 1.0, 0.5, -1.0, 0.0, 2.0, 1.0, -1.0};
     for (size_t k = 0; k < sizeof val / sizeof *val; ++k)
         ck_assert_msg(odhs_solver_set_param(a, bad[k], val[k]) == ODHS_E_INVALID, "%s = %g accepted", bad[k],
                       val[k]);
@@ -521,8 +521,24 @@ static void check_hyperstatic(au_case *c, const char *what, size_t expect_nullit
                     if (cfg == 0) ck_assert_msg(strstr(why, "spqr failed"), "why = \"%s\"", why);
 #endif
                 } else {
-                    /* the backend that answered is kept for the next solves */
-                    ck_assert_msg(strstr(why, "lsq-svd (kept"), "why = \"%s\"", why);
+                    /* least squares is not kept by default (retry_after_lsq
+                     * = 0: an SVD costs far more than a failed Cholesky):
+                     * the primary is tried, and fails, again */
+                    ck_assert_msg(strstr(why, "failed") && strstr(why, "-> lsq-svd"), "why = \"%s\"", why);
+                    /* with retry_after_lsq it is kept for the next solves */
+                    odhs_solver *k = au_solver("auto");
+                    if (cfg == 1) CK_OK(odhs_solver_set_param(k, "suitesparse", 0.0));
+                    CK_OK(odhs_solver_set_param(k, "retry_after_lsq", 20.0));
+                    for (int rep = 0; rep < 2; ++rep) {
+                        memset(x, 0, c->nc * sizeof *x);
+                        CK_OK(odhs_solver_solve(k, c->net, b, x));
+                    }
+                    const char *kwhy, *kname = au_backend(k, &kwhy);
+                    ck_assert_str_eq(kname, "lsq-svd");
+                    ck_assert_msg(strstr(kwhy, "lsq-svd (kept"), "why = \"%s\"", kwhy);
+                    ck_assert_msg(au_reldiff(c->nc, x, xr) <= tol, "kept lsq-svd: forces differ");
+                    ck_assert_double_eq(au_stat(k, "fallbacks"), au_stat(a, "fallbacks") / 2.0);
+                    odhs_solver_destroy(k);
                 }
             } else {
                 /* cg from zero on the consistent singular system: minimum

@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "odhs.h"
-#include "geom/geom.h" /* odhs__remap_strain */
+#include "geom/geom.h" /* odhs__remap_strain, odhs__wrap */
 
 static char dir[64];
 
@@ -725,6 +725,119 @@ START_TEST(test_remap_extreme_aspect)
 }
 END_TEST
 
+/* a coordinate 1e20 box lengths out: floor(x/L) L is rounded, and the old
+ * wrap left 124 of 1000 such coordinates outside [0, L) (a 2D file of box
+ * 4.9 x 7.3e78 at fixed pressure stepped a particle to x = 1.9e50; the
+ * checkpoint written then could not be read back: fuzz_checkpoint, finding
+ * 14, seed regress_wrap_far_coordinate.ckpt). Near coordinates keep their
+ * old arithmetic bit for bit. */
+START_TEST(test_wrap_far)
+{
+    const double L[3] = {4.9120538521719572, 7.2535731079894922e78, 3.0};
+    size_t bad = 0;
+    for (int k = 0; k < 1000; ++k) {
+        for (int sgn = -1; sgn <= 1; sgn += 2) {
+            double x[3] = {sgn * 1e20 * (1 + k * 1e-3), 1.0, sgn * 3e30 * (1 + k * 1e-3)};
+            odhs__wrap(3, L, 0.25, x);
+            bad += !(x[0] >= 0.0 && x[0] < L[0]) + !(x[2] >= 0.0 && x[2] < L[2]) + (x[1] != 1.0);
+            /* y far out: x shifted by the image count, then wrapped */
+            double y[3] = {1.0, sgn * 1e95 * (1 + k * 1e-3), 0.5};
+            odhs__wrap(3, L, 0.25, y);
+            bad += !(y[0] >= 0.0 && y[0] < L[0]) + !(y[1] >= 0.0 && y[1] < L[1]) + (y[2] != 0.5);
+        }
+    }
+    ck_assert_uint_eq(bad, 0);
+    /* near coordinates: the old arithmetic (x - floor(x/L) L, one more L for
+     * a rounded-up residual, a rounded-down one at 0) */
+    const double B[2] = {3.7, 2.9};
+    for (int k = -400; k <= 400; ++k) {
+        double v = 0.0173 * k + 1e-17 * (k % 3), x[2] = {v, 1.0}, y[2] = {1.0, v};
+        odhs__wrap(2, B, -0.3, x);
+        double m = floor(v / B[0]), want = v - m * B[0];
+        if (want >= B[0]) want -= B[0];
+        if (want < 0.0) want = 0.0;
+        if (v >= 0.0 && v < B[0]) want = v;
+        ck_assert_msg(x[0] == want && x[1] == 1.0, "x = %.17g: %.17g, want %.17g", v, x[0], want);
+        odhs__wrap(2, B, -0.3, y);
+        double ny = floor(v / B[1]), wy = v - ny * B[1], wx = 1.0 - ny * -0.3 * B[1];
+        if (wy >= B[1]) {
+            wy -= B[1];
+            wx -= -0.3 * B[1];
+        }
+        if (wy < 0.0) wy = 0.0;
+        if (v >= 0.0 && v < B[1]) wy = v, wx = 1.0;
+        if (wx < 0.0 || wx >= B[0]) {
+            double mx = floor(wx / B[0]);
+            wx -= mx * B[0];
+            if (wx >= B[0]) wx -= B[0];
+            if (wx < 0.0) wx = 0.0;
+        }
+        ck_assert_msg(y[1] == wy && y[0] == wx, "y = %.17g: (%.17g, %.17g), want (%.17g, %.17g)", v, y[0], y[1],
+                      wx, wy);
+    }
+    /* a box edge scaled through zero by a trial motion (refused by the
+     * caller): the old arithmetic, not the fmod fallback (the first version
+     * of the fallback took it there, and a fixed-pressure run of the Python
+     * tests failed with a non-finite force right-hand side) */
+    const double Bn[2] = {-0.39891220601691568, 3.0};
+    for (int k = 0; k < 50; ++k) {
+        double v = 0.0085 * k, x[2] = {v, 1.0};
+        odhs__wrap(2, Bn, 0.1, x);
+        double m = floor(v / Bn[0]), want = v - m * Bn[0];
+        if (want >= Bn[0]) want -= Bn[0];
+        if (want < 0.0) want = 0.0;
+        ck_assert_msg(x[0] == want && x[1] == 1.0, "negative edge, x = %.17g: %.17g, want %.17g", v, x[0], want);
+    }
+}
+END_TEST
+
+/* a fuzzed 2D file at fixed pressure with a shear rate of 5.3e269: its first
+ * step's force solve gave kappa = 3.7e54, so the compression rate
+ * c = kappa * gammadot overflowed and the velocity gradient's diagonal was
+ * -inf; the step returned ODHS_OK, and the checkpoint written after it could
+ * not be read back (fuzz_checkpoint, finding 15; the reproducer is the seed
+ * tests/fuzz/corpus_checkpoint/regress_flow_overflow.ckpt). Now the step
+ * fails with ODHS_E_NONFINITE and is rolled back. */
+START_TEST(test_flow_overflow)
+{
+    const char *data = getenv("ODHS_TEST_DATA");
+    char path[512], err[256];
+    snprintf(path, sizeof path, "%s/../fuzz/corpus_checkpoint/regress_flow_overflow.ckpt",
+             data && *data ? data : "tests/data");
+    size_t len = 0;
+    unsigned char *buf = slurp(path, &len);
+    ck_assert_msg(buf != NULL && len > 16, "cannot read %s", path);
+    wr64(buf + len - 8, fnv1a(buf, len - 8)); /* the fuzzer repairs the checksum */
+    odhs_solver *sol;
+    odhs_system *s;
+    odhs_driver *d;
+    odhs_stepper *st;
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &sol), ODHS_OK);
+    ck_assert_msg(odhs_checkpoint_parse(buf, len, sol, &s, &d, &st, err, sizeof err) == ODHS_OK, "%s", err);
+    double t0, t1;
+    ck_assert_int_eq(odhs_stepper_time(st, &t0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_step(st, NULL), ODHS_E_NONFINITE);
+    ck_assert(strstr(odhs_stepper_errmsg(st), "non-finite flow") != NULL);
+    ck_assert_int_eq(odhs_stepper_time(st, &t1), ODHS_OK);
+    ck_assert(t1 == t0); /* rolled back */
+    char out[128];
+    snprintf(out, sizeof out, "%s/flow_overflow.ckpt", dir);
+    ck_assert_int_eq(odhs_checkpoint_write(st, out), ODHS_OK);
+    odhs_system *s2;
+    odhs_driver *d2;
+    odhs_stepper *st2;
+    ck_assert_msg(odhs_checkpoint_read(out, sol, &s2, &d2, &st2, err, sizeof err) == ODHS_OK, "%s", err);
+    odhs_stepper_destroy(st2);
+    odhs_driver_destroy(d2);
+    odhs_system_destroy(s2);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(d);
+    odhs_system_destroy(s);
+    odhs_solver_destroy(sol);
+    free(buf);
+}
+END_TEST
+
 Suite *make_checkpoint_suite(void)
 {
     Suite *s = suite_create("checkpoint");
@@ -746,6 +859,8 @@ Suite *make_checkpoint_suite(void)
     tcase_add_test(tc, test_sections_round_trip);
     tcase_add_test(tc, test_stepper_shapes);
     tcase_add_test(tc, test_remap_extreme_aspect);
+    tcase_add_test(tc, test_wrap_far);
+    tcase_add_test(tc, test_flow_overflow);
     suite_add_tcase(s, tc);
     return s;
 }

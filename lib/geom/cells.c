@@ -11,6 +11,25 @@
 
 #include "geom/geom.h"
 
+/* a residual x still >= L after the subtraction of floor(x/L) L and one
+ * more L, or below -L: the coordinate was many box lengths out (an extreme
+ * box or a wild step; fuzz_checkpoint, finding 14), where that product is
+ * rounded. The exact remainder fmod puts it in [0, L); returns the image
+ * count removed. Never taken for a coordinate a few box lengths out, whose
+ * arithmetic (and bits) stay as they were, nor for a box edge that is not
+ * positive (a trial motion can scale the box through zero; the step is then
+ * refused by its caller, and the old arithmetic must stay: 0.2.13's first
+ * version broke a fixed-pressure run of the Python tests there). */
+static double wrap_far(double *x, double L)
+{
+    double r = fmod(*x, L);
+    if (r < 0.0) r += L;
+    if (r >= L) r = 0.0;
+    double m = (*x - r) / L;
+    *x = r;
+    return m;
+}
+
 void odhs__wrap(int dim, const double *L, double gamma, double *x)
 {
     if (x[1] < 0.0 || x[1] >= L[1]) {
@@ -21,6 +40,7 @@ void odhs__wrap(int dim, const double *L, double gamma, double *x)
             x[1] -= L[1];
             x[0] -= gamma * L[1];
         }
+        if (L[1] > 0.0 && (x[1] >= L[1] || x[1] < -L[1])) x[0] -= wrap_far(&x[1], L[1]) * gamma * L[1];
         if (x[1] < 0.0) x[1] = 0.0;
     }
     for (int k = 0; k < dim; k += (k == 0 ? 2 : 1)) { /* k = 0, then 2 */
@@ -28,6 +48,7 @@ void odhs__wrap(int dim, const double *L, double gamma, double *x)
             double m = floor(x[k] / L[k]);
             x[k] -= m * L[k];
             if (x[k] >= L[k]) x[k] -= L[k];
+            if (L[k] > 0.0 && (x[k] >= L[k] || x[k] < -L[k])) wrap_far(&x[k], L[k]);
             if (x[k] < 0.0) x[k] = 0.0;
         }
     }

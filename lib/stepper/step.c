@@ -38,6 +38,19 @@ static int undo(odhs_stepper *st, const step_undo *u, int s)
     return s;
 }
 
+/* The flow the force solve left: a velocity gradient or compression rate
+ * that overflowed (a huge shear rate times a large kappa: fuzz_checkpoint,
+ * finding 15) fails the step, which is rolled back, instead of being kept
+ * and written into a checkpoint that the reader refuses. */
+static int check_flow(odhs_stepper *st)
+{
+    int ok = isfinite(st->kappa);
+    for (int k = 0; k < 9 && ok; ++k) ok = isfinite(st->G[k]);
+    if (ok) return ODHS_OK;
+    return odhs__sterr(st, ODHS_E_NONFINITE,
+                       "non-finite flow after the force solve (kappa = %g; rates too large?)", st->kappa);
+}
+
 /* The driver changed since the forces were solved (or propulsion switches
  * are overdue, e.g. on a driver shared by steppers): re-solve. *done when the
  * new driving opened or closed contacts: that is this step's event, at the
@@ -53,7 +66,7 @@ static int driver_update(odhs_stepper *st, step_undo *u, odhs_event *first, int 
     u->psaved = 1;
     odhs__prop_start(st->drv, st->time, st->lambda);
     odhs__prop_switch(st->drv, st->time, st->lambda);
-    if ((s = odhs__st_external_forces(st)) || (s = odhs__st_rewire(st))) return s;
+    if ((s = odhs__st_external_forces(st)) || (s = odhs__st_rewire(st)) || (s = check_flow(st))) return s;
     st->drv_version = st->drv->version;
     if (!st->nchg) return ODHS_OK;
     st->nsteps++;
@@ -158,6 +171,7 @@ static int end_step(odhs_stepper *st, const odhs__step_plan *p, step_undo *u, od
         st->corr_skipped = 0;
         if ((s = odhs__st_correct(st, &added)) || (s = odhs__st_rewire(st))) return s;
     }
+    if ((s = check_flow(st))) return s;
     return odhs__st_emit_events(st, first, stop);
 }
 
@@ -219,7 +233,7 @@ int odhs_stepper_correct(odhs_stepper *st)
     const int jammed0 = st->jammed;
     st->nchg = 0;
     if ((s = odhs__st_correct(st, &added))) goto fail;
-    if ((s = odhs__st_rewire(st))) goto fail;
+    if ((s = odhs__st_rewire(st)) || (s = check_flow(st))) goto fail;
     if ((s = odhs__st_emit_events(st, NULL, &stop))) goto fail;
     if (st->jammed) return ODHS_JAMMED;
     return stop ? ODHS_STOPPED : ODHS_OK;
