@@ -118,6 +118,9 @@ typedef struct {
     double cpu;              /* CPU s of the steady part in earlier processes */
     int nb, stopped;
     double bmu[4096], bphi[4096];
+    /* results of the steady part, set when the run ends (not saved) */
+    double steady_strain;
+    uint64_t steps, events;
 } seed_run;
 
 static const char *state_dir; /* ODHS_BENCH_STATE_DIR: resumable runs */
@@ -247,11 +250,9 @@ static void run_seed(int dim, size_t n, unsigned seed, double p, long nsamp, dou
     CHECK(odhs_stepper_counts(r.st, &st1, &c1, &o1));
     double gend;
     CHECK(odhs_stepper_strain(r.st, &gend));
-    /* reuse st1/c1/o1 through the fields: the steady part's counts */
-    sr->st0 = st1 - sr->st0;
-    sr->c0 = (c1 + o1) - (sr->c0 + sr->o0);
-    sr->o0 = 0;
-    sr->g0 = sr->steady ? gend - sr->g0 - transient : 0.0; /* steady strain */
+    sr->steps = st1 - sr->st0;
+    sr->events = (c1 + o1) - (sr->c0 + sr->o0);
+    sr->steady_strain = sr->steady ? gend - sr->g0 - transient : 0.0;
     finish(&r);
 }
 
@@ -292,9 +293,9 @@ static point measure(int dim, size_t n, int seeds, double strain, double transie
         nz += sr->nz;
         if (sr->steady) {
             cpu += sr->cpu;
-            steady += sr->g0;
-            events += sr->c0;
-            steps += sr->st0;
+            steady += sr->steady_strain;
+            events += sr->events;
+            steps += sr->steps;
         }
     }
     mean_err(bmu, pt.nblocks, &pt.mu, &pt.mu_err);

@@ -61,6 +61,9 @@
 #include "solvers/solvers.h"
 
 enum { B_CG, B_DENSE, B_CHOLMOD, B_CHOLMOD_PCG, B_SPQR, B_LSQ_SVD, B_LSQ_CG, B_COUNT };
+
+/* the least-squares routes (the answer on rank-deficient networks) */
+static int is_lsq(int b) { return b == B_LSQ_SVD || b == B_LSQ_CG; }
 static const char *const bname[B_COUNT] = {"cg", "dense", "cholmod", "cholmod-pcg", "spqr", "lsq-svd", "lsq-cg"};
 #define NHANDLES 5 /* B_CG..B_SPQR have handles; lsq-cg uses its own cg handle */
 
@@ -143,7 +146,7 @@ static int auto_set_param(void *state, const char *key, double v)
         if (s->sticky_left > s->retry_after) s->sticky_left = s->retry_after;
     } else if (!strcmp(key, "retry_after_lsq") && v >= 0.0 && v <= 1e9) {
         s->retry_after_lsq = (int)v;
-        if ((s->sticky_backend == B_LSQ_SVD || s->sticky_backend == B_LSQ_CG) && s->sticky_left > s->retry_after_lsq)
+        if (is_lsq(s->sticky_backend) && s->sticky_left > s->retry_after_lsq)
             s->sticky_left = s->retry_after_lsq;
     }
     else if (!strcmp(key, "suitesparse") && (v == 0.0 || v == 1.0)) {
@@ -339,7 +342,7 @@ static int auto_run(auto_state *s, const odhs_network *net, const double *b, con
                 snprintf(note + len, sizeof note - len, " -> %s", bname[b_]);
                 memcpy(s->why, note, sizeof note);
                 s->sticky_backend = b_;
-                s->sticky_left = b_ == B_LSQ_SVD || b_ == B_LSQ_CG ? s->retry_after_lsq : s->retry_after;
+                s->sticky_left = is_lsq(b_) ? s->retry_after_lsq : s->retry_after;
             } else if (b_ != prim) {
                 snprintf(s->why, sizeof s->why, "%s (kept after an earlier fallback)", bname[b_]);
             } else {
@@ -347,7 +350,7 @@ static int auto_run(auto_state *s, const odhs_network *net, const double *b, con
                 if (s->sticky_backend == b_) s->sticky_backend = -1;
             }
             if (b_ != prim) s->fallback_solves += 1.0;
-            if (b_ == B_LSQ_SVD || b_ == B_LSQ_CG) s->rank_deficient += 1.0;
+            if (is_lsq(b_)) s->rank_deficient += 1.0;
             else s->last_rank = NAN;
             return ODHS_OK;
         }
@@ -387,7 +390,7 @@ static int auto_get_stat(void *state, const char *key, double *v)
     else if (!strcmp(key, "last_failure")) *v = s->last_failure;
     else if (!strcmp(key, "suitesparse")) *v = s->have_ss;
     else if (!strcmp(key, "tol")) *v = s->tol > 0.0 ? s->tol : 1e-12; /* the iterative backends' default */
-    else if (s->last == B_LSQ_SVD || s->last == B_LSQ_CG) {
+    else if (is_lsq(s->last)) {
         if (!strcmp(key, "rank")) *v = s->last_rank;
         else if (s->last == B_LSQ_CG) return odhs_solver_get_stat(s->lsqcg, key, v);
         else if (!strcmp(key, "iterations")) *v = 0.0;
