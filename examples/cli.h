@@ -134,10 +134,11 @@ typedef struct {
 /* ---- the options several examples take ------------------------------------- */
 
 /* the integrators of the stepper, by index (--integrator) */
-static const char *const cli_integrators[] = {"euler", "heun", NULL};
+static const char *const cli_integrators[] = {"euler", "heun", "batched", NULL};
 #define CLI_DEFAULT_INTEGRATOR ODHS_INTEGRATOR_HEUN /* the library's default */
 #define CLI_DEFAULT_SOLVER "auto"                   /* the library's automatic choice */
-_Static_assert(ODHS_INTEGRATOR_EULER == 0 && ODHS_INTEGRATOR_HEUN == 1, "cli_integrators is indexed by the enum");
+_Static_assert(ODHS_INTEGRATOR_EULER == 0 && ODHS_INTEGRATOR_HEUN == 1 && ODHS_INTEGRATOR_BATCHED == 2,
+               "cli_integrators is indexed by the enum");
 
 #define CLI_SOLVER_HELP                                                                                              \
     "linear solver: auto (a direct or preconditioned solver chosen by size, with fallbacks), cg, dense, cholmod, "   \
@@ -159,9 +160,18 @@ _Static_assert(ODHS_INTEGRATOR_EULER == 0 && ODHS_INTEGRATOR_HEUN == 1, "cli_int
 #define CLI_SERIES(p, columns) CLI_OPT_STRING("--series", p, "FILE.csv", "write " columns " per output interval", CLI_ANY)
 #define CLI_SOLVER(p) CLI_OPT_STRING("--solver", p, "NAME", CLI_SOLVER_HELP, CLI_ANY)
 #define CLI_INTEGRATOR(p)                                                                                            \
-    CLI_OPT_LIST("--integrator", p, "NAME", "heun (adaptive, steps of at most --dt) or euler (the paper's fixed step " \
-                 "--dt; paper mode: --integrator euler --solver cg)", cli_integrators, CLI_ANY)
-#define CLI_TOL(p) CLI_OPT_DOUBLE("--tol", p, "X", "heun: error per step relative to the mean diameter", CLI_OPEN(0, 1))
+    CLI_OPT_LIST("--integrator", p, "NAME", "heun (adaptive, steps of at most --dt), euler (the paper's fixed step " \
+                 "--dt; paper mode: --integrator euler --solver cg) or batched (steps not cut at collisions, many " \
+                 "events per step: large N)", cli_integrators, CLI_ANY)
+/* 0 keeps the integrator's own default (odhs_stepper_set_tolerance) */
+#define CLI_TOL(p)                                                                                                   \
+    CLI_OPT_DOUBLE("--tol", p, "X", "heun, batched: error per step relative to the mean diameter", CLI_OPEN(0, 1),  \
+                   .deftext = "the integrator's: 1e-6 heun, 1e-3 batched")
+/* set the tolerance given with --tol (0: the integrator's default) */
+static inline int cli_set_tolerance(odhs_stepper *st, double tol)
+{
+    return tol > 0.0 ? odhs_stepper_set_tolerance(st, tol) : ODHS_OK;
+}
 /* unit: what --dt and --every are measured in */
 #define CLI_DT(p, unit) CLI_OPT_DOUBLE("--dt", p, "X", "step in " unit, CLI_POSITIVE)
 #define CLI_EVERY(p, unit) CLI_OPT_DOUBLE("--every", p, "X", "output interval in " unit, CLI_POSITIVE)

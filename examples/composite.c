@@ -89,7 +89,7 @@ int main(int argc, char **argv)
 {
     const char *series = NULL, *plot = NULL, *svg = NULL, *outpath = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double phi = 0.70, strain = 1.0, every = 0.05, tol = 1e-6, traj_every = 0.0;
+    double phi = 0.70, strain = 1.0, every = 0.05, tol = 0.0, traj_every = 0.0;
     unsigned long nb = 100, k = 3, seed = 1;
     int integrator = CLI_DEFAULT_INTEGRATOR, quiet = 0;
     const cli_opt opts[] = {
@@ -133,7 +133,7 @@ int main(int argc, char **argv)
     CHECK(odhs_driver_create(&drv));
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
     CHECK(odhs_stepper_set_integrator(st, integrator));
-    CHECK(odhs_stepper_set_tolerance(st, tol));
+    CHECK(cli_set_tolerance(st, tol));
     /* drift correction after every step: bodies rigid to round-off at every
      * output (bond_error column), at the price of one extra solve per step.
      * Set explicitly, so it stays 1 with --integrator euler too (whose own

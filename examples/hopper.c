@@ -113,7 +113,7 @@ int main(int argc, char **argv)
 {
     const char *series = NULL, *plot = NULL, *svg = NULL, *outpath = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double outlet = 3.2, width = 24.0, tmax = 400.0, every = 1.0, tol = 1e-6, traj_every = 0.0;
+    double outlet = 3.2, width = 24.0, tmax = 400.0, every = 1.0, tol = 0.0, traj_every = 0.0;
     unsigned long n = 300, seed = 1;
     int integrator = CLI_DEFAULT_INTEGRATOR, quiet = 0;
     const cli_opt opts[] = {
@@ -207,7 +207,7 @@ int main(int argc, char **argv)
     CHECK(odhs_stepper_add_wall_segment(st, a0, b0, NULL)); /* wall 0: left  */
     CHECK(odhs_stepper_add_wall_segment(st, a1, b1, NULL)); /* wall 1: right */
     CHECK(odhs_stepper_set_integrator(st, integrator));
-    CHECK(odhs_stepper_set_tolerance(st, tol));
+    CHECK(cli_set_tolerance(st, tol));
     CHECK(odhs_stepper_set_dt(st, 0.05));
     double tau;
     CHECK(odhs_driver_time_unit(drv, sys, &tau));

@@ -120,7 +120,7 @@ int main(int argc, char **argv)
     const char *in = NULL, *outpath = NULL, *series = NULL, *plot = NULL;
     const char *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double T = 20.0, tmax = 10.0, every = 1.0, dt = 1e-2, phi = 0.5, tol = 1e-6, traj_every = 0.0;
+    double T = 20.0, tmax = 10.0, every = 1.0, dt = 1e-2, phi = 0.5, tol = 0.0, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
     int dim = 2, integrator = CLI_DEFAULT_INTEGRATOR, quiet = 0;
     const cli_opt opts[] = {
@@ -189,7 +189,7 @@ int main(int argc, char **argv)
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
     CHECK(odhs_stepper_set_dt(st, dt));
     CHECK(odhs_stepper_set_integrator(st, integrator));
-    CHECK(odhs_stepper_set_tolerance(st, tol));
+    CHECK(cli_set_tolerance(st, tol));
     double tau;
     CHECK(odhs_driver_time_unit(drv, sys, &tau));
     if (!quiet)

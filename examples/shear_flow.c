@@ -254,7 +254,7 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL, *plot = NULL, *contacts = NULL;
-    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 1e-6, traj_every = 0.0;
+    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 0.0, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
     int dim = 2, integrator = CLI_DEFAULT_INTEGRATOR, shape = 0, quiet = 0;
     const char *oscillate = NULL;
@@ -350,7 +350,7 @@ int main(int argc, char **argv)
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
     CHECK(odhs_stepper_set_dt(st, dt));
     CHECK(odhs_stepper_set_integrator(st, integrator));
-    CHECK(odhs_stepper_set_tolerance(st, tol));
+    CHECK(cli_set_tolerance(st, tol));
     rc = odhs_stepper_reset(st);
     if (rc) {
         fprintf(stderr, "shear_flow: %s\n", odhs_stepper_errmsg(st));

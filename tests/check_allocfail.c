@@ -811,7 +811,7 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
     case 0: return odhs_driver_create(&f->drv);
     case 1: {
         int s = odhs_driver_set_shear_rate(f->drv, 1.0);
-        if (!s && v == 2) s = odhs_driver_set_pressure(f->drv, 0.05);
+        if (!s && (v == 2 || v == 8)) s = odhs_driver_set_pressure(f->drv, 0.05);
         /* 5: a high pressure: isostatic networks flow (the bordered solve,
          * its sub-network, the sparse f0 and zero-pressure self-stress) */
         if (!s && v == 5) s = odhs_driver_set_pressure(f->drv, 1e4);
@@ -834,10 +834,13 @@ static int shear_op(af_fix *f, const af_scenario *sc, int k)
             f->sol2 = dn;
             return ODHS_OK;
         }
-        return odhs_solver_create_by_name(v == 1 || v == 3 || v == 5 || v == 6 ? "dense" : "cg", &f->sol);
+        return odhs_solver_create_by_name(v == 1 || v == 3 || v >= 5 ? "dense" : "cg", &f->sol);
     case 3: return odhs_stepper_create(f->sys, f->drv, f->sol, &f->st);
     case 4: return odhs_stepper_set_dt(f->st, 0.02);
     case 5:
+        /* 7, 8: the batched integrator (its contact problem, rejected steps
+         * and exact fallbacks), at fixed volume and fixed pressure */
+        if (v >= 7) return odhs_stepper_set_integrator(f->st, ODHS_INTEGRATOR_BATCHED);
         return odhs_stepper_set_integrator(f->st, v == 1 || v == 3 || v == 5 || v == 6 ? ODHS_INTEGRATOR_HEUN
                                                                              : ODHS_INTEGRATOR_EULER);
     case 6: {
@@ -1502,6 +1505,8 @@ static const af_scenario scenarios[] = {
     {"shear_cg_fallback", SH_NOPS, 4, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_pressure_high", SH_NOPS, 5, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"shear_callback", SH_NOPS, 6, shear_setup, NULL, shear_op, shear_capture, shear_final},
+    {"shear_batched", SH_NOPS, 7, shear_setup, NULL, shear_op, shear_capture, shear_final},
+    {"shear_batched_pressure", SH_NOPS, 8, shear_setup, NULL, shear_op, shear_capture, shear_final},
     {"jam", 0, 0, jam_setup, jam_probe, jam_op, jam_capture, jam_final},
 #if ODHS_HAVE_CLP
     {"jam_lp", 7, 0, jam_lp_setup, NULL, jam_lp_op, jam_lp_capture, jam_lp_final},

@@ -1654,7 +1654,7 @@ static int huge_rate_case(void)
     X(st_integrator_null, odhs_stepper_set_integrator, ODHS_E_NULL, NOALT, H_NONE, 0,                          \
       return odhs_stepper_set_integrator(NULL, ODHS_INTEGRATOR_HEUN);)                                         \
     X(st_integrator_bad, odhs_stepper_set_integrator, ODHS_E_INVALID, NOALT, H_ST, 0,                          \
-      return odhs_stepper_set_integrator(w->st, 2);)                                                           \
+      return odhs_stepper_set_integrator(w->st, 3);)                                                           \
     X(st_integrator_negative, odhs_stepper_set_integrator, ODHS_E_INVALID, NOALT, H_RUN, 0,                    \
       return odhs_stepper_set_integrator(w->run, -1);)                                                         \
     X(st_tol_null, odhs_stepper_set_tolerance, ODHS_E_NULL, NOALT, H_NONE, 0, return odhs_stepper_set_tolerance(NULL, 1e-6);) \
@@ -1832,6 +1832,10 @@ static int huge_rate_case(void)
       uint64_t r; double h; return odhs_stepper_adaptive_stats(NULL, &r, &h);)                                 \
     X(st_adaptive_all_null, odhs_stepper_adaptive_stats, ODHS_OK, NOALT, H_NONE, 0,                            \
       return odhs_stepper_adaptive_stats(w->run, NULL, NULL);)                                                 \
+    X(st_batched_stats_null, odhs_stepper_batched_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                        \
+      uint64_t a; return odhs_stepper_batched_stats(NULL, &a, &a, &a);)                                        \
+    X(st_batched_stats_all_null, odhs_stepper_batched_stats, ODHS_OK, NOALT, H_NONE, 0,                        \
+      return odhs_stepper_batched_stats(w->run, NULL, NULL, NULL);)                                            \
     X(st_rewire_stats_null, odhs_stepper_rewire_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                          \
       uint64_t c; return odhs_stepper_rewire_stats(NULL, &c);)                                                 \
     X(st_rewire_stats_out_null, odhs_stepper_rewire_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                      \

@@ -237,6 +237,16 @@ START_TEST(test_bit_identical_driver_changed)
 }
 END_TEST
 
+/* the batched integrator: its step size and tolerance come back with the
+ * file (fixed volume, fixed pressure with a driver change, 3D) */
+START_TEST(test_bit_identical_batched)
+{
+    run_and_compare(2, ODHS_INTEGRATOR_BATCHED, "dense", 0);
+    run_and_compare(2, ODHS_INTEGRATOR_BATCHED, "dense", RC_PRESSURE | RC_DRVCHANGE);
+    run_and_compare(3, ODHS_INTEGRATOR_BATCHED, "cg", 0);
+}
+END_TEST
+
 START_TEST(test_bit_identical_gravity_shear_2d) { run_and_compare(2, ODHS_INTEGRATOR_EULER, "dense", RC_GRAVITY); }
 END_TEST
 
@@ -846,6 +856,7 @@ Suite *make_checkpoint_suite(void)
     tcase_set_timeout(tc, 300);
     tcase_add_test(tc, test_bit_identical_euler_2d);
     tcase_add_test(tc, test_bit_identical_heun_2d);
+    tcase_add_test(tc, test_bit_identical_batched);
     tcase_add_test(tc, test_bit_identical_pressure_2d);
     tcase_add_test(tc, test_bit_identical_3d);
     tcase_add_test(tc, test_bit_identical_propulsion_2d);

@@ -88,7 +88,26 @@ enum {
      *  estimate): the step is chosen so that the estimated non-affine position
      *  error of a step stays below tol times the mean diameter, up to dt;
      *  2 force solves per accepted step; contact gaps drift as O(h^3). */
-    ODHS_INTEGRATOR_HEUN = 1
+    ODHS_INTEGRATOR_HEUN = 1,
+    /** Batched events (since 0.2.14): a step of size h is not truncated at
+     *  collisions. Pairs that would close within the step take part in it
+     *  as unilateral constraints on their end gaps, linearised at the start
+     *  (gap + h S V >= 0, forces >= 0, complementary: time-stepping contact
+     *  dynamics, as Moreau-Jean's or Maury-Venel's scheme), so a step takes
+     *  many events at once and its cost no longer follows the number of
+     *  events. The linearised gap bounds the real one from below: no pair
+     *  overlaps at a step end; pairs whose constraint is active end touching
+     *  and join the network (collisions), contacts whose force would be
+     *  negative leave it (openings). Events are reported at the end of their
+     *  step (time resolution h). First order in h: an error controller keeps
+     *  h/2 times the root mean square (over particles) change of the
+     *  non-affine velocities over a step below tol times the mean diameter
+     *  (default tol 1e-3, steps up to dt; odhs_stepper_set_tolerance).
+     *  Drift correction after every step. A step whose contact problem is
+     *  degenerate (a potentially jammed constrained set, a singular solve)
+     *  is taken by the exact Heun scheme instead (odhs_stepper_batched_stats
+     *  counts them). */
+    ODHS_INTEGRATOR_BATCHED = 2
 };
 
 /** Step size in units of tau (default 1e-3): the fixed step of
@@ -101,8 +120,12 @@ ODHS_API int odhs_stepper_set_dt(odhs_stepper *st, double dt);
  *  with odhs_stepper_set_correction_interval, which is then kept. (Before
  *  version 0.2 the default was ODHS_INTEGRATOR_EULER.) */
 ODHS_API int odhs_stepper_set_integrator(odhs_stepper *st, int integrator);
-/** Error tolerance of the adaptive integrator (relative to the mean diameter,
- *  per step; default 1e-6; in (0, 1)). */
+/** Error tolerance of the adaptive integrators (relative to the mean
+ *  diameter, per step; in (0, 1)). Default: 1e-6 for ODHS_INTEGRATOR_HEUN,
+ *  1e-3 for ODHS_INTEGRATOR_BATCHED (whose error is a root mean square over
+ *  particles, Heun's the maximum); odhs_stepper_set_integrator brings its
+ *  integrator's default unless a tolerance was set here, which is then kept
+ *  (as is the tolerance of a stepper read from a checkpoint). */
 ODHS_API int odhs_stepper_set_tolerance(odhs_stepper *st, double tol);
 /** Drift correction every k steps (0 disables). Default: 1 with
  *  ODHS_INTEGRATOR_HEUN, 10 (the paper's) with ODHS_INTEGRATOR_EULER; once
@@ -228,6 +251,13 @@ ODHS_API int odhs_stepper_get_settings(const odhs_stepper *st, int *integrator, 
 /** Adaptive-integrator counters: rejected steps and the current step (in tau
  *  units); either may be NULL. */
 ODHS_API int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejected, double *h);
+/** Counters of the batched integrator (ODHS_INTEGRATOR_BATCHED; any output
+ *  may be NULL): accepted batched steps, steps taken by the exact Heun
+ *  scheme instead (a degenerate contact problem), and force solves of the
+ *  steps' contact problems (rejected steps included). Counted since the
+ *  stepper was created or read from a checkpoint. Since 0.2.14. */
+ODHS_API int odhs_stepper_batched_stats(const odhs_stepper *st, uint64_t *batched_steps, uint64_t *exact_steps,
+                                        uint64_t *solves);
 /** Rewirings that the anti-cycling method finished (since 0.2.2). The
  *  paper's rule (drop the most negative force, re-connect the most
  *  approaching removed pair; Sect. IV B) can cycle on degenerate networks

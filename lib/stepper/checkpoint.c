@@ -135,12 +135,13 @@ int odhs__ckpt_read_stepper(odhs__ckpt_in *in)
     odhs__get_f64s(b, st->M, 9);
     uint64_t stale = odhs__get_u64(b);
     uint64_t npairs = odhs__get_u64(b);
-    if (b->bad || integ > ODHS_INTEGRATOR_HEUN || corr > 0xffffffffu || jam > 1 || stale > 1 ||
+    if (b->bad || integ > ODHS_INTEGRATOR_BATCHED || corr > 0xffffffffu || jam > 1 || stale > 1 ||
         npairs > (b->len - b->pos) / 16)
         return odhs__ckpt_bad(in, "checkpoint: stepper section malformed");
     st->integrator = (int)integ;
     st->corr_every = (unsigned)corr;
     st->corr_user = 1; /* the file's interval is kept by set_integrator */
+    st->tol_user = 1;  /* and so is its tolerance */
     st->jammed = (int)jam;
     st->nb_stale = (int)stale;
     if ((s = check_stepper(in, st))) return s;

@@ -84,7 +84,8 @@ int odhs__st_solve(odhs_stepper *st, const double *b, double *x)
 }
 
 /* b = -S (V_aff + xi0 F) / xi0 on the current network (st->cb has room),
- * with the pressure part of V_aff left out */
+ * with the pressure part of V_aff left out (and, in a batched step's
+ * contact problem, - gap / (bh xi0)) */
 double odhs__st_affine_rate(const odhs_stepper *st, const double *G, size_t c)
 {
     const odhs_network *net = st->net;
@@ -127,6 +128,9 @@ void odhs__st_affine_rhs(odhs_stepper *st, double *b)
             const double *Fi = st->F + net->ci[c] * dim, *Fj = st->F + net->cj[c] * dim;
             for (int k = 0; k < dim; ++k) v += xi0 * (Fj[k] - Fi[k]) * n[k];
         }
+        /* the batched step's contact problem (batched.c): the gap closes
+         * over the step bh, gap rate -gap / bh instead of 0 */
+        if (st->bh > 0.0) v += net->gap[c] / st->bh;
         b[c] = -v / xi0;
     }
 }

@@ -289,5 +289,5 @@ static int heun_at_opening(odhs_stepper *st, odhs__step_plan *p, int *again)
 /* default drift-correction interval: every step, since the adaptive chord's
  * errors (O(h^3), either sign) would otherwise leave overlaps of ~1e-11 at
  * tol 1e-6 (docs/accuracy.md) */
-const odhs__step_type odhs__step_heun = {ODHS_INTEGRATOR_HEUN, "heun", 1u,         heun_begin,
-                                         heun_plan,            heun_early, heun_at_collision, heun_at_opening};
+const odhs__step_type odhs__step_heun = {ODHS_INTEGRATOR_HEUN, "heun", 1u, heun_begin, heun_plan, heun_early,
+                                         heun_at_collision,    heun_at_opening, NULL, NULL, 1e-6};

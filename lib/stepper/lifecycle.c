@@ -79,7 +79,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
     void *arrays[] = {st->disps, st->U0,  st->Ua,    st->Up, st->F,  st->U,     st->tmp,   st->cb,
                       st->cx,    st->pi,  st->pj,    st->disp, st->rem, st->fpj,  st->pj_res, st->chg,
                       st->xs,    st->sci, st->scj,   st->skind, st->sf, st->fr,   st->srest, st->ev,
-                      st->wsnap, st->pre_b, st->pre_f};
+                      st->wsnap, st->pre_b, st->pre_f, st->bviol};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
 }
@@ -106,6 +106,7 @@ int odhs_stepper_set_integrator(odhs_stepper *st, int integrator)
     st->integrator = integrator;
     st->h = st->dt;
     if (!st->corr_user) st->corr_every = type->corr_default;
+    if (!st->tol_user) st->tol = type->tol_default;
     return ODHS_OK;
 }
 
@@ -116,6 +117,7 @@ int odhs_stepper_set_tolerance(odhs_stepper *st, double tol)
     if (!isfinite(tol) || !(tol > 0.0) || !(tol < 1.0))
         return odhs__sterr(st, ODHS_E_INVALID, "tolerance %g must be in (0, 1)", tol);
     st->tol = tol;
+    st->tol_user = 1;
     return ODHS_OK;
 }
 
@@ -143,6 +145,16 @@ int odhs__stepper_set_rewire_mode(odhs_stepper *st, int mode)
     st->errmsg[0] = '\0'; /* a successful call leaves no message */
     if (mode != 0 && mode != 1) return odhs__sterr(st, ODHS_E_INVALID, "rewire mode %d is not 0 or 1", mode);
     st->rewire_mode = mode;
+    return ODHS_OK;
+}
+
+int odhs_stepper_batched_stats(const odhs_stepper *st, uint64_t *batched_steps, uint64_t *exact_steps,
+                               uint64_t *solves)
+{
+    if (!st) return ODHS_E_NULL;
+    if (batched_steps) *batched_steps = st->nbatched;
+    if (exact_steps) *exact_steps = st->nbatched_exact;
+    if (solves) *solves = st->nbatched_solves;
     return ODHS_OK;
 }
 

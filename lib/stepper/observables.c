@@ -79,6 +79,10 @@ int odhs_stepper_pre_event_stress(const odhs_stepper *st, double *sigma)
         return odhs__sterr(st, ODHS_E_STATE, "the last step only applied a change of the driver: no motion, no record");
     case ODHS__PRE_PRESSURE:
         return odhs__sterr(st, ODHS_E_STATE, "the pre-event stress is not recorded under pressure control");
+    case ODHS__PRE_BATCHED:
+        return odhs__sterr(st, ODHS_E_STATE,
+                           "the last step was a batched one (ODHS_INTEGRATOR_BATCHED): its events are spread over "
+                           "it, no record");
     case ODHS__PRE_SOLVE:
         return odhs__sterr(st, ODHS_E_STATE,
                            "the force solve on the network of the last step's start failed at its end configuration");

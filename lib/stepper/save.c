@@ -77,11 +77,9 @@ static void restore_clock(odhs_stepper *st)
     st->nsteps = st->nsteps_s;
 }
 
-void odhs__st_rollback(odhs_stepper *st)
+void odhs__st_restore_network(odhs_stepper *st)
 {
     odhs_network *net = st->net;
-    odhs__st_restore_motion(st);
-    restore_clock(st);
     odhs_network_clear(net);
     for (size_t c = 0; c < st->snc; ++c) {
         size_t k = odhs__net_add(net, st->sci[c], st->scj[c], st->skind[c]);
@@ -90,6 +88,13 @@ void odhs__st_rollback(odhs_stepper *st)
         if (st->skind[c] == ODHS_CONTACT_PERMANENT) net->rest[k] = st->srest[c];
     }
     odhs__net_geometry(net, st->sys);
+}
+
+void odhs__st_rollback(odhs_stepper *st)
+{
+    odhs__st_restore_motion(st);
+    restore_clock(st);
+    odhs__st_restore_network(st);
     memcpy(st->G, st->Gs, sizeof st->G);
     st->kappa = st->kappas;
     /* velocities and external forces as they were (recomputing them from the

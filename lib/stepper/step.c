@@ -9,7 +9,7 @@
 /* the integrators (step types) the library has */
 const odhs__step_type *odhs__step_type_find(int id)
 {
-    static const odhs__step_type *const types[] = {&odhs__step_euler, &odhs__step_heun};
+    static const odhs__step_type *const types[] = {&odhs__step_euler, &odhs__step_heun, &odhs__step_batched};
     for (size_t k = 0; k < sizeof types / sizeof types[0]; ++k)
         if (types[k]->id == id) return types[k];
     return NULL;
@@ -90,7 +90,7 @@ static int fit_neighbours(odhs_stepper *st, odhs__step_plan *p)
 }
 
 /* move by p->t along the chord; the clock follows */
-static int move(odhs_stepper *st, odhs__step_plan *p)
+int odhs__st_move(odhs_stepper *st, odhs__step_plan *p)
 {
     odhs__st_advance(st, p->G, p->vel, p->t);
     if (st->net->nwalls) odhs__st_advance_walls(st, p->t);
@@ -119,7 +119,7 @@ static int repeat(odhs_stepper *st, int (*hook)(odhs_stepper *, odhs__step_plan 
 /* Sect. IV A (i)-(ii): the chord, the first collision on it, the motion to
  * it, the new contact and the external forces at the step's end; the scheme
  * may repeat the step shorter (a collision or an opening inside it) */
-static int advance_to_event(odhs_stepper *st, const odhs__step_type *type, odhs__step_plan *p)
+int odhs__st_advance_exact(odhs_stepper *st, const odhs__step_type *type, odhs__step_plan *p)
 {
     int s, again;
     for (;;) {
@@ -127,7 +127,7 @@ static int advance_to_event(odhs_stepper *st, const odhs__step_type *type, odhs_
         p->t = odhs__st_predict(st, p->G, p->vel, p->tplan, EPS_V * odhs__st_velocity_scale(st), 1,
                                 type->early ? 2 : 1, &p->ci, &p->cj);
         if (type->early && type->early(st, p)) continue;
-        if ((s = move(st, p)) || (s = repeat(st, type->at_collision, p, &again))) return s;
+        if ((s = odhs__st_move(st, p)) || (s = repeat(st, type->at_collision, p, &again))) return s;
         if (again) continue;
         /* the external forces at the end time do not depend on the network:
          * evaluated before the new contact, so that the pre-event record
@@ -145,8 +145,8 @@ static int advance_to_event(odhs_stepper *st, const odhs__step_type *type, odhs_
 /* Sect. IV A (iii)-(iv) and IV C: new forces of the driver at a switch time,
  * drift correction (before the rewiring: its solve is then that of the
  * corrected geometry, and contacts the correction adds are rewired with the
- * step's events), rewiring, events */
-static int end_step(odhs_stepper *st, const odhs__step_plan *p, step_undo *u, odhs_event *first, int *stop)
+ * step's events), rewiring; the events follow (do_step) */
+static int end_step(odhs_stepper *st, const odhs__step_plan *p, step_undo *u)
 {
     int s;
     if (p->at_switch) {
@@ -171,8 +171,7 @@ static int end_step(odhs_stepper *st, const odhs__step_plan *p, step_undo *u, od
         st->corr_skipped = 0;
         if ((s = odhs__st_correct(st, &added)) || (s = odhs__st_rewire(st))) return s;
     }
-    if ((s = check_flow(st))) return s;
-    return odhs__st_emit_events(st, first, stop);
+    return check_flow(st);
 }
 
 /* One step: limit is the largest time to advance (INFINITY for none); *stop
@@ -210,7 +209,20 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     p.dsw = p.tsw - st->time;
     p.limit = p.dsw <= limit ? p.dsw : limit;
     st->pre_pend_state = ODHS__PRE_NONE;
-    if ((s = advance_to_event(st, type, &p)) || (s = end_step(st, &p, &u, first, stop))) return undo(st, &u, s);
+    for (;;) {
+        int again = 0;
+        s = type->advance ? type->advance(st, &p) : odhs__st_advance_exact(st, type, &p);
+        if (s || (s = end_step(st, &p, &u)) || (type->judge && (s = type->judge(st, &p, &again))))
+            return undo(st, &u, s);
+        if (!again) break;
+        /* the scheme took the step back: anew, to the same limit */
+        const double limit1 = p.limit, tsw = p.tsw, dsw = p.dsw;
+        memset(&p, 0, sizeof p);
+        p.limit = limit1;
+        p.tsw = tsw;
+        p.dsw = dsw;
+    }
+    if ((s = odhs__st_emit_events(st, first, stop))) return undo(st, &u, s);
     if (st->pre_on) {
         st->pre_state = st->pre_pend_state;
         memcpy(st->pre_sigma, st->pre_pend, sizeof st->pre_sigma);

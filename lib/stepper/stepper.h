@@ -37,6 +37,12 @@ struct odhs_stepper {
     double dt;
     int integrator;   /* ODHS_INTEGRATOR_* */
     double tol;       /* adaptive: error per step, relative to the mean diameter */
+    int tol_user;     /* the tolerance was set (not the integrator's default) */
+    double bh;        /* > 0 while the batched step's contact problem is solved:
+                       * the step, over which each contact's gap closes (forces.c) */
+    uint64_t nbatched, nbatched_exact, nbatched_solves; /* batched.c (not checkpointed) */
+    odhs_change *bviol; /* batched.c: the pairs a contact problem closes */
+    size_t bviolcap;
     double h;         /* adaptive: current step in units of tau */
     double lambda;    /* mean diameter */
     double *U0, *Ua;  /* adaptive: velocities at the start, averaged (nd) */
@@ -140,7 +146,7 @@ struct odhs_stepper {
 
 /* ==== shared by the stepper's files ======================================== */
 /* states of the pre-event stress record (odhs_stepper_pre_event_stress) */
-enum { ODHS__PRE_NONE = 0, ODHS__PRE_OK, ODHS__PRE_DRIVER, ODHS__PRE_PRESSURE, ODHS__PRE_SOLVE };
+enum { ODHS__PRE_NONE = 0, ODHS__PRE_OK, ODHS__PRE_DRIVER, ODHS__PRE_PRESSURE, ODHS__PRE_SOLVE, ODHS__PRE_BATCHED };
 /* the stress tensor (dim x dim) of contact forces f on the current network */
 void odhs__st_stress_of(const odhs_stepper *st, const double *f, double *sigma);
 /* record the stress at the current configuration on the current network
@@ -184,6 +190,7 @@ typedef struct {
     int at_switch;     /* the step ended at the switch time */
     int relocated;     /* the step was repeated with a shorter chord */
     int nhalve;        /* times the planned step was halved */
+    int exact;         /* a batched step taken by the exact scheme instead (batched.c) */
 } odhs__step_plan;
 
 typedef struct {
@@ -203,10 +210,25 @@ typedef struct {
     /* likewise after the external forces at the end of a step without a
      * collision (an opening inside the step) */
     int (*at_opening)(odhs_stepper *st, odhs__step_plan *p, int *again);
+    /* a step type that is not truncated at collisions: the whole motion of
+     * the step (replaces chord, prediction and the hooks above; NULL: the
+     * event-driven loop of step.c) */
+    int (*advance)(odhs_stepper *st, odhs__step_plan *p);
+    /* after the step's end (drift correction and rewiring), before its
+     * events are emitted: *again = 1 after putting the state back to the
+     * start of the step, to take it anew (an error controller) */
+    int (*judge)(odhs_stepper *st, odhs__step_plan *p, int *again);
+    double tol_default; /* the tolerance this integrator starts with */
 } odhs__step_type;
 
 extern const odhs__step_type odhs__step_euler; /* euler.c: the paper's scheme */
 extern const odhs__step_type odhs__step_heun;  /* heun.c: adaptive Heun */
+extern const odhs__step_type odhs__step_batched; /* batched.c: batched events */
+/* the event-driven step (chord, first collision, motion) of a step type,
+ * for a batched step that falls back to it (step.c) */
+int odhs__st_advance_exact(odhs_stepper *st, const odhs__step_type *type, odhs__step_plan *p);
+/* move by p->t along the chord p->G, p->vel; the clock follows (step.c) */
+int odhs__st_move(odhs_stepper *st, odhs__step_plan *p);
 /* the step type of ODHS_INTEGRATOR_* id, NULL if none (step.c) */
 const odhs__step_type *odhs__step_type_find(int id);
 
@@ -269,6 +291,8 @@ int odhs__st_save(odhs_stepper *st);
 void odhs__st_restore_motion(odhs_stepper *st);
 /* the whole saved state back (a failed step) */
 void odhs__st_rollback(odhs_stepper *st);
+/* the network of the saved state back (contacts, kinds, forces, rest lengths) */
+void odhs__st_restore_network(odhs_stepper *st);
 /* the forces and flow now are the step's start (odhs__st_restart) */
 void odhs__st_mark_start(odhs_stepper *st);
 /* back to the start of the step before any contact changed, with the

@@ -28,6 +28,7 @@ class Integrator(enum.IntEnum):
 
     EULER = lib.ODHS_INTEGRATOR_EULER  # the paper's explicit Euler with a fixed step
     HEUN = lib.ODHS_INTEGRATOR_HEUN  # adaptive Heun (the default)
+    BATCHED = lib.ODHS_INTEGRATOR_BATCHED  # batched events: steps not cut at collisions (large N)
 
 
 class Oscillation(enum.IntEnum):

@@ -26,6 +26,9 @@ RunLimits.__doc__ = "Guards of the run calls (odhs_stepper_get_run_limits); 0 = 
 
 AdaptiveStats = collections.namedtuple("AdaptiveStats", "rejected h")
 AdaptiveStats.__doc__ = "Adaptive-integrator counters: rejected steps and the current step h in units of tau."
+BatchedStats = collections.namedtuple("BatchedStats", "batched_steps exact_steps solves")
+BatchedStats.__doc__ = ("Batched-integrator counters: accepted batched steps, steps taken by the exact scheme instead, "
+                        "force solves of the steps' contact problems.")
 
 Errors = collections.namedtuple("Errors", "contact_gap overlap")
 Errors.__doc__ = """Largest |gap|/(a_i+a_j) over contacts and largest overlap -gap/(a_i+a_j) over all

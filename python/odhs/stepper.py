@@ -17,7 +17,7 @@ from .constants import EventKind, Feature, Integrator, to_enum
 from .driver import Driver
 from .errors import last_error, make_error
 from .network import Network
-from .records import (AdaptiveStats, Certificate, Contacts, Counts, Errors, Event, JamLpReport, RunLimits, Settings,
+from .records import (AdaptiveStats, BatchedStats, Certificate, Contacts, Counts, Errors, Event, JamLpReport, RunLimits, Settings,
                       StepInfo)
 from .solver import Solver
 from .system import System
@@ -155,7 +155,7 @@ class Stepper(Owned):
     @property
     def integrator(self):
         """Integrator.HEUN (default, adaptive) or Integrator.EULER (the
-        paper's); strings "heun", "euler" accepted (odhs_stepper_set_integrator)."""
+        paper's), Integrator.BATCHED; strings "heun", "euler", "batched" accepted (odhs_stepper_set_integrator)."""
         return self.settings.integrator
 
     @integrator.setter
@@ -166,7 +166,7 @@ class Stepper(Owned):
 
     @property
     def tolerance(self):
-        """Error tolerance of the adaptive integrator (default 1e-6;
+        """Error tolerance of the adaptive integrators (default 1e-6 for Heun, 1e-3 batched;
         odhs_stepper_set_tolerance)."""
         return self.settings.tolerance
 
@@ -377,6 +377,16 @@ class Stepper(Owned):
         if rc:
             self._err(rc, "Stepper.adaptive_stats")
         return AdaptiveStats(int(r[0]), h[0])
+
+    @property
+    def batched_stats(self):
+        """BatchedStats(batched_steps, exact_steps, solves) of the batched
+        integrator (odhs_stepper_batched_stats)."""
+        a, b, c = ffi.new("uint64_t *"), ffi.new("uint64_t *"), ffi.new("uint64_t *")
+        rc = lib.odhs_stepper_batched_stats(self._p or self._closed(), a, b, c)
+        if rc:
+            self._err(rc, "Stepper.batched_stats")
+        return BatchedStats(int(a[0]), int(b[0]), int(c[0]))
 
     @property
     def rewire_count(self):

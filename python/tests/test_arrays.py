@@ -200,3 +200,17 @@ def test_step_ex_and_the_remaining_getters(run):
     k = net.find(0, 1)
     assert net.rest_length(k, s) == 2.0 and net.contact(k)[2] == odhs.ContactKind.PERMANENT
     assert net.coordination == pytest.approx(2 * net.count / s.n)
+
+
+def test_batched_integrator(run):
+    """The batched integrator from Python: its default tolerance, its
+    counters, no overlap and power balance after its steps."""
+    s, _ = run
+    st = odhs.Stepper(s.clone(), odhs.Driver(shear_rate=1.0), odhs.Solver("dense"), integrator="batched", dt=1e-2)
+    assert st.settings.integrator == odhs.Integrator.BATCHED and st.tolerance == 1e-3
+    assert st.batched_stats == (0, 0, 0)
+    st.run_until_strain(0.05)
+    b = st.batched_stats
+    assert b.batched_steps > 0 and b.solves >= b.batched_steps
+    assert st.errors.overlap <= 1e-12
+    assert st.power == pytest.approx(st.dissipation, rel=1e-9)

@@ -1,0 +1,377 @@
+/* bench/batched - the batched-event integrator against the exact one:
+ * cost per unit strain against N (issue "Beyond one step per event").
+ *
+ * Scene per N: 50:50 bidisperse discs (radii 0.5/0.7, 3% polydispersity) at
+ * phi = 0.80 in 2D, or spheres at phi = 0.60 in 3D: random placement (0.45
+ * in 2D, 0.30 in 3D), compression at rate 1 with the batched integrator
+ * (solver auto), drift correction. Above NBUILD (default 16384) the start is
+ * a periodic 2^d tiling of the packing of N / 2^d (repeated): the copies
+ * start identical and part by round-off and chaos under shear.
+ * Warm-up: shear at rate 1 to strain 0.05 with the batched integrator (not
+ * timed). Then from that state, each setting in its own process (its peak
+ * resident set size is its memory):
+ *   exact      the library's defaults (adaptive Heun, tol 1e-6), solver auto,
+ *              over the strain that holds EVENTS events (default 1000; from
+ *              the warm-up's event rate); skipped above EXACT_NMAX
+ *   batched    ODHS_INTEGRATOR_BATCHED at its default tolerance (1e-3), dt
+ *              1e-3 (the library's), over strain 0.05 (at least 50 steps)
+ *   tight      the same at tol 1e-4
+ * Cost per unit strain = CPU seconds of the process / strain. Fitted
+ * exponents (least squares of log cost on log N) and an SVG plot.
+ *
+ * usage: batched [DIM] [NLIST] [SVG] [EXACT_NMAX] [EVENTS] [NBUILD]
+ *        defaults 2  1024,4096,16384,65536  batched_2d.svg  16384  1000  16384
+ *        batched --memory DIM N: a few batched steps at N (tiled), peak RSS
+ */
+#define _GNU_SOURCE
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bench.h"
+#include "odhs.h"
+#include "../examples/plot.h"
+
+enum { S_EXACT, S_BATCHED, S_TIGHT, S_COUNT };
+static const char *const sname[S_COUNT] = {"exact (defaults)", "batched tol 1e-3", "batched tol 1e-4"};
+
+typedef struct {
+    int rc;
+    double strain, cpu, wall;
+    uint64_t steps, events, nbatched, nexact;
+    double sxy, p, z;
+} run_result;
+
+/* a packing of n particles at phi by batched compression */
+static int compress(int dim, size_t n, double phi, odhs_system **out)
+{
+    odhs_system *sys;
+    odhs_solver *sol = NULL;
+    odhs_driver *drv = NULL;
+    odhs_stepper *st = NULL;
+    int rc = odhs_system_create(dim, n, &sys);
+    if (!rc) rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, (unsigned)(11 + n));
+    if (!rc) rc = odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.30, (unsigned)(12 + n));
+    if (!rc) rc = odhs_solver_create_by_name("auto", &sol);
+    if (!rc) rc = odhs_driver_create(&drv);
+    if (!rc) rc = odhs_driver_set_compression_rate(drv, 1.0);
+    if (!rc) rc = odhs_stepper_create(sys, drv, sol, &st);
+    if (!rc) rc = odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_BATCHED);
+    if (!rc) rc = odhs_stepper_run_until_packing_fraction(st, phi);
+    if (!rc) rc = odhs_stepper_correct(st);
+    if (rc) fprintf(stderr, "batched: compression of N = %zu failed: %s\n", n, st ? odhs_stepper_errmsg(st) : "");
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    if (rc) odhs_system_destroy(sys);
+    else *out = sys;
+    return rc;
+}
+
+/* 2^dim periodic tiling of an unsheared box */
+static int tile(const odhs_system *base, odhs_system **out)
+{
+    int dim = odhs_system_dim(base);
+    size_t n = odhs_system_count(base), m = n << dim, k = 0;
+    double L[3] = {1, 1, 1}, *x = malloc(n * dim * sizeof *x), *r = malloc(n * sizeof *r);
+    double *X = malloc(m * dim * sizeof *X), *R = malloc(m * sizeof *R);
+    int rc = !x || !r || !X || !R ? ODHS_E_NOMEM : ODHS_OK;
+    if (!rc) rc = odhs_system_get_box(base, L);
+    if (!rc) rc = odhs_system_get_positions(base, x);
+    if (!rc) rc = odhs_system_get_radii(base, r);
+    for (int c = 0; !rc && c < (1 << dim); ++c)
+        for (size_t p = 0; p < n; ++p, ++k) {
+            for (int a = 0; a < dim; ++a) X[k * dim + a] = x[p * dim + a] + ((c >> a) & 1) * L[a];
+            R[k] = r[p];
+        }
+    double L2[3] = {2 * L[0], 2 * L[1], 2 * L[2]};
+    if (!rc) rc = odhs_system_create(dim, m, out);
+    if (!rc) rc = odhs_system_set_configuration(*out, L2, 0.0, R, X);
+    free(x);
+    free(r);
+    free(X);
+    free(R);
+    return rc;
+}
+
+/* the start of N: built, or tiled from N / 2^dim */
+static int start_of(int dim, size_t n, size_t nbuild, odhs_system **out)
+{
+    double phi = dim == 2 ? 0.80 : 0.60;
+    if (n <= nbuild || n % ((size_t)1 << dim)) return compress(dim, n, phi, out);
+    odhs_system *base;
+    int rc = start_of(dim, n >> dim, nbuild, &base);
+    if (rc) return rc;
+    rc = tile(base, out);
+    odhs_system_destroy(base);
+    return rc;
+}
+
+static odhs_stepper *shear_stepper(odhs_system *sys, int setting, odhs_solver **sol, odhs_driver **drv)
+{
+    odhs_stepper *st = NULL;
+    odhs_solver_create_by_name("auto", sol);
+    odhs_driver_create(drv);
+    odhs_driver_set_shear_rate(*drv, 1.0);
+    odhs_stepper_create(sys, *drv, *sol, &st);
+    if (setting != S_EXACT) odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_BATCHED);
+    if (setting == S_TIGHT) odhs_stepper_set_tolerance(st, 1e-4);
+    return st;
+}
+
+/* shear sys over strain w with a setting; the result */
+static void run(odhs_system *sys, int setting, double w, run_result *r)
+{
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st = shear_stepper(sys, setting, &sol, &drv);
+    memset(r, 0, sizeof *r);
+    double w0 = bench_wall(), c0 = bench_cpu();
+    r->rc = odhs_stepper_reset(st);
+    if (!r->rc) r->rc = odhs_stepper_run_until_strain(st, w);
+    r->cpu = bench_cpu() - c0;
+    r->wall = bench_wall() - w0;
+    if (r->rc) fprintf(stderr, "batched: %s failed: %s\n", sname[setting], odhs_stepper_errmsg(st));
+    uint64_t co = 0, op = 0;
+    odhs_stepper_counts(st, &r->steps, &co, &op);
+    odhs_stepper_batched_stats(st, &r->nbatched, &r->nexact, NULL);
+    odhs_stepper_shear_stress(st, &r->sxy);
+    odhs_stepper_pressure(st, &r->p);
+    odhs_stepper_coordination(st, &r->z);
+    r->events = co + op;
+    r->strain = w;
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+}
+
+/* run fn in a child process: its result through a pipe, its peak RSS */
+typedef void (*child_fn)(void *arg, void *out);
+static int in_child(child_fn fn, void *arg, void *out, size_t size, double *rss_mib)
+{
+    int pfd[2];
+    if (pipe(pfd)) return 1;
+    pid_t pid = fork();
+    if (pid == 0) {
+        close(pfd[0]);
+        fn(arg, out);
+        ssize_t w = write(pfd[1], out, size);
+        _exit(w == (ssize_t)size ? 0 : 1);
+    }
+    close(pfd[1]);
+    ssize_t got = read(pfd[0], out, size);
+    close(pfd[0]);
+    struct rusage ru;
+    int status = 0;
+    wait4(pid, &status, 0, &ru);
+    *rss_mib = ru.ru_maxrss / 1024.0;
+    return got != (ssize_t)size;
+}
+
+typedef struct {
+    int dim;
+    size_t n, nbuild;
+    const char *path; /* the warmed-up start, as a checkpoint */
+    int setting;
+    double w;
+} job;
+
+typedef struct {
+    int rc;
+    size_t nc;
+    double phi, build_s, events_per_strain;
+} built;
+
+/* child: build, warm up, write the start */
+static void build_child(void *arg, void *out)
+{
+    const job *j = arg;
+    built *b = out;
+    memset(b, 0, sizeof *b);
+    double t0 = bench_wall();
+    odhs_system *sys;
+    if ((b->rc = start_of(j->dim, j->n, j->nbuild, &sys))) return;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
+    b->rc = odhs_stepper_reset(st);
+    if (!b->rc) b->rc = odhs_stepper_run_until_strain(st, 0.05);
+    if (!b->rc) b->rc = odhs_stepper_correct(st);
+    uint64_t co = 0, op = 0;
+    odhs_stepper_counts(st, NULL, &co, &op);
+    b->events_per_strain = (double)(co + op) / 0.05;
+    b->nc = odhs_network_count(odhs_stepper_network(st));
+    odhs_system_packing_fraction(sys, &b->phi);
+    if (!b->rc) b->rc = odhs_checkpoint_write(st, j->path);
+    if (b->rc) fprintf(stderr, "batched: start N = %zu failed (%d): %s\n", j->n, b->rc, odhs_stepper_errmsg(st));
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(sys);
+    b->build_s = bench_wall() - t0;
+}
+
+/* child: one setting from the start */
+static void run_child(void *arg, void *out)
+{
+    const job *j = arg;
+    run_result *r = out;
+    memset(r, 0, sizeof *r);
+    odhs_solver *sol;
+    odhs_system *sys;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    odhs_solver_create_by_name("auto", &sol);
+    if ((r->rc = odhs_checkpoint_read(j->path, sol, &sys, &drv, &st, NULL, 0))) {
+        odhs_solver_destroy(sol);
+        return;
+    }
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    run(sys, j->setting, j->w, r);
+    odhs_system_destroy(sys);
+}
+
+/* --memory: a few batched steps at N */
+static int memory(int dim, size_t n, size_t nbuild)
+{
+    odhs_system *sys;
+    double t0 = bench_wall();
+    if (start_of(dim, n, nbuild, &sys)) return 1;
+    double tb = bench_wall() - t0, c0 = bench_cpu();
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
+    int rc = odhs_stepper_reset(st);
+    for (int k = 0; k < 5 && !rc; ++k) rc = odhs_stepper_step(st, NULL);
+    uint64_t co = 0;
+    odhs_stepper_counts(st, NULL, &co, NULL);
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    printf("# memory: %dD N = %zu (start %.0f s wall), 5 batched steps: status %d (%s), %llu collisions, %.1f CPU s, "
+           "peak RSS %.1f MiB\n",
+           dim, n, tb, rc, rc ? odhs_stepper_errmsg(st) : "ok", (unsigned long long)co, bench_cpu() - c0,
+           ru.ru_maxrss / 1024.0);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(sys);
+    return rc != 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 3 && !strcmp(argv[1], "--memory"))
+        return memory(atoi(argv[2]), (size_t)atol(argv[3]), argc > 4 ? (size_t)atol(argv[4]) : 16384);
+    int dim = argc > 1 ? atoi(argv[1]) : 2;
+    size_t ns[16], nn = 0;
+    {
+        char buf[256];
+        snprintf(buf, sizeof buf, "%s", argc > 2 ? argv[2] : "1024,4096,16384,65536");
+        for (char *t = strtok(buf, ","); t && nn < 16; t = strtok(NULL, ",")) ns[nn++] = (size_t)atol(t);
+    }
+    const char *svg = argc > 3 ? argv[3] : (dim == 2 ? "batched_2d.svg" : "batched_3d.svg");
+    size_t exact_nmax = argc > 4 ? (size_t)atol(argv[4]) : 16384;
+    double events = argc > 5 ? atof(argv[5]) : 1000.0;
+    size_t nbuild = argc > 6 ? (size_t)atol(argv[6]) : 16384;
+    if ((dim != 2 && dim != 3) || nn == 0) {
+        fprintf(stderr, "usage: batched [DIM] [NLIST] [SVG] [EXACT_NMAX] [EVENTS] [NBUILD]\n");
+        return 2;
+    }
+    char cpu[256], path[64];
+    bench_cpu_model(cpu, sizeof cpu);
+    double la[3];
+    bench_loadavg(la);
+    snprintf(path, sizeof path, "/tmp/odhs_bench_batched_%ld.ckpt", (long)getpid());
+    printf("# batched-event integrator against the exact one: cost per unit strain against N, %dD bidisperse, phi = "
+           "%.2f, shear rate 1\n",
+           dim, dim == 2 ? 0.80 : 0.60);
+    printf("# machine: %s (%ld logical CPUs); libodhs %s; load average at the start %.2f %.2f %.2f\n", cpu,
+           sysconf(_SC_NPROCESSORS_ONLN), odhs_version_string(), la[0], la[1], la[2]);
+    printf("# start: batched compression (tiled above N = %zu), warm-up to strain 0.05 (batched); solver auto\n",
+           nbuild);
+    printf("# exact: library defaults over %g events (from the warm-up's rate), skipped above N = %zu; batched: "
+           "strain 0.05, dt 1e-3; every setting in its own process\n",
+           events, exact_nmax);
+    printf("%6s %6s %6s %-17s %9s %7s %8s %8s %9s %12s %11s %8s %7s %7s %6s %8s\n", "N", "Nc", "phi", "setting",
+           "strain", "steps", "exact", "events", "cpu_s", "cpu_s/strain", "ev/strain", "speedup", "sxy", "p", "z",
+           "rss_MiB");
+    fflush(stdout);
+    double cost[S_COUNT][16];
+    int ok[S_COUNT][16];
+    memset(ok, 0, sizeof ok);
+    for (size_t q = 0; q < nn; ++q) {
+        job j = {dim, ns[q], nbuild, path, 0, 0.0};
+        built b;
+        double rss;
+        if (in_child(build_child, &j, &b, sizeof b, &rss) || b.rc) {
+            printf("%6zu start failed\n", ns[q]);
+            continue;
+        }
+        for (int s = 0; s < S_COUNT; ++s) {
+            if (s == S_EXACT && ns[q] > exact_nmax) {
+                printf("%6zu %6zu %6.4f %-17s skipped (N > %zu)\n", ns[q], b.nc, b.phi, sname[s], exact_nmax);
+                continue;
+            }
+            j.setting = s;
+            j.w = s == S_EXACT ? fmin(0.05, fmax(1e-4, events / fmax(b.events_per_strain, 1.0))) : 0.05;
+            run_result r;
+            if (in_child(run_child, &j, &r, sizeof r, &rss) || r.rc) {
+                printf("%6zu %6zu %6.4f %-17s failed (%d)\n", ns[q], b.nc, b.phi, sname[s], r.rc);
+                continue;
+            }
+            cost[s][q] = r.cpu / r.strain;
+            ok[s][q] = 1;
+            char sp[16] = "-";
+            if (s != S_EXACT && ok[S_EXACT][q]) snprintf(sp, sizeof sp, "%.1fx", cost[S_EXACT][q] / cost[s][q]);
+            printf("%6zu %6zu %6.4f %-17s %9.2e %7llu %8llu %8llu %9.2f %12.1f %11.3g %8s %7.4f %7.4f %6.3f %8.1f\n",
+                   ns[q], b.nc, b.phi, sname[s], r.strain, (unsigned long long)r.steps,
+                   (unsigned long long)r.nexact, (unsigned long long)r.events, r.cpu, cost[s][q],
+                   (double)r.events / r.strain, sp, r.sxy, r.p, r.z, rss);
+            fflush(stdout);
+        }
+        printf("# N = %zu: start %.0f s wall%s\n", ns[q], b.build_s, ns[q] > nbuild ? " (tiled)" : "");
+    }
+    remove(path);
+    pl_plot p;
+    char title[96];
+    snprintf(title, sizeof title, "Cost per unit strain, %dD, phi = %.2f", dim, dim == 2 ? 0.80 : 0.60);
+    pl_init(&p, title, "N", "CPU seconds per unit strain", 1, 1);
+    for (int s = 0; s < S_COUNT; ++s) {
+        double x[16], y[16];
+        size_t m = 0;
+        for (size_t q = 0; q < nn; ++q)
+            if (ok[s][q]) {
+                x[m] = (double)ns[q];
+                y[m++] = cost[s][q];
+            }
+        if (!m) continue;
+        int k = pl_series_add(&p, sname[s], s, 0, s + 1);
+        for (size_t i = 0; i < m; ++i) pl_point(&p, k, x[i], y[i]);
+        if (m >= 2) {
+            double a = 0.0, e = pl_fit_loglog(x, y, m, &a);
+            printf("# %s: cost per unit strain ~ N^%.2f (least-squares fit, %zu sizes, N = %zu..%zu)\n", sname[s], e,
+                   m, (size_t)x[0], (size_t)x[m - 1]);
+            char lab[64];
+            snprintf(lab, sizeof lab, "fit N^%.2f", e);
+            int f = pl_series_add(&p, lab, s, 1, 0);
+            pl_point(&p, f, x[0], exp(a) * pow(x[0], e));
+            pl_point(&p, f, x[m - 1], exp(a) * pow(x[m - 1], e));
+        }
+    }
+    char note[300];
+    snprintf(note, sizeof note, "%.120s, %ld CPUs (load %.1f); exact over %g events, batched over strain 0.05", cpu,
+             sysconf(_SC_NPROCESSORS_ONLN), la[0], events);
+    pl_note(&p, note);
+    if (pl_write_svg(&p, svg)) fprintf(stderr, "batched: cannot write %s\n", svg);
+    else printf("# plot: %s\n", svg);
+    pl_free(&p);
+    return 0;
+}

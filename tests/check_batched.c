@@ -1,0 +1,486 @@
+/* Check suite "batched": the batched-event integrator
+ * (ODHS_INTEGRATOR_BATCHED): convergence to the exact scheme as the step
+ * falls (analytic two-disc case, a 2D shear), invariants after every step
+ * (no overlap, no negative force, power balance) in 2D and 3D at fixed
+ * volume and fixed pressure, rate invariance, settings. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "odhs.h"
+
+typedef struct {
+    odhs_system *sys;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st;
+} bscene;
+
+static void bscene_free(bscene *s)
+{
+    odhs_stepper_destroy(s->st);
+    odhs_driver_destroy(s->drv);
+    odhs_solver_destroy(s->sol);
+    odhs_system_destroy(s->sys);
+}
+
+/* dense scene: random placement, compression to phi with the exact scheme */
+static odhs_system *packing(int dim, size_t n, double phi, unsigned seed)
+{
+    odhs_system *sys;
+    bscene c;
+    ck_assert_int_eq(odhs_system_create(dim, n, &sys), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed), ODHS_OK);
+    ck_assert_int_eq(odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.3, seed + 1), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &c.sol), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&c.drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_compression_rate(c.drv, 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(sys, c.drv, c.sol, &c.st), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_run_until_packing_fraction(c.st, phi), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_correct(c.st), ODHS_OK);
+    c.sys = NULL;
+    bscene_free(&c);
+    return sys;
+}
+
+/* a clone of start, sheared at rate gd (pressure p > 0: fixed pressure) */
+static void sheared(bscene *s, const odhs_system *start, double gd, double p, int integrator, double dt, double tol)
+{
+    ck_assert_int_eq(odhs_system_clone(start, &s->sys), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &s->sol), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&s->drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_shear_rate(s->drv, gd), ODHS_OK);
+    if (p > 0) ck_assert_int_eq(odhs_driver_set_pressure(s->drv, p), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(s->sys, s->drv, s->sol, &s->st), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_integrator(s->st, integrator), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_dt(s->st, dt), ODHS_OK);
+    if (tol > 0) ck_assert_int_eq(odhs_stepper_set_tolerance(s->st, tol), ODHS_OK);
+}
+
+typedef struct {
+    double overlap, gap, negative, power;
+    size_t steps;
+} worst;
+
+/* the invariants now: non-contact overlap, contact gap, most negative
+ * force relative to the largest, power balance */
+static void invariants(odhs_stepper *st, worst *w)
+{
+    odhs_jam_certificate cert;
+    cert.size = sizeof cert;
+    double gap, D, P;
+    ck_assert_int_eq(odhs_stepper_errors(st, &gap, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_certificate(st, &cert), ODHS_OK);
+    w->overlap = fmax(w->overlap, cert.overlap);
+    w->gap = fmax(w->gap, gap);
+    ck_assert_int_eq(odhs_stepper_dissipation(st, &D), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_power(st, &P), ODHS_OK);
+    if (D > 0) w->power = fmax(w->power, fabs(D - P) / D);
+    const odhs_network *net = odhs_stepper_network(st);
+    size_t nc = odhs_network_count(net);
+    if (nc) {
+        /* bonds (permanent contacts) may pull */
+        double *f = malloc(nc * sizeof *f), fbig = 0.0, fmin = 0.0;
+        int *kind = malloc(nc * sizeof *kind);
+        ck_assert_int_eq(odhs_network_get_forces(net, f), ODHS_OK);
+        ck_assert_int_eq(odhs_network_get_contacts(net, NULL, NULL, kind), ODHS_OK);
+        for (size_t c = 0; c < nc; ++c) {
+            fbig = fmax(fbig, fabs(f[c]));
+            if (kind[c] != ODHS_CONTACT_PERMANENT) fmin = fmin < f[c] ? fmin : f[c];
+        }
+        if (fbig > 0) w->negative = fmax(w->negative, -fmin / fbig);
+        free(f);
+        free(kind);
+    }
+    w->steps++;
+}
+
+/* run to strain gamma one step at a time (landing on gamma), checking the
+ * invariants after every step */
+static void run_checked(odhs_stepper *st, double gamma, worst *w)
+{
+    memset(w, 0, sizeof *w);
+    ck_assert_int_eq(odhs_stepper_set_run_limits(st, 1, 1000), ODHS_OK);
+    for (int k = 0; k < 1000000; ++k) {
+        int rc = odhs_stepper_run_until_strain(st, gamma);
+        ck_assert_msg(rc == ODHS_OK || rc == ODHS_STEP_LIMIT, "step: %s (%s)", odhs_strerror(rc),
+                      odhs_stepper_errmsg(st));
+        invariants(st, w);
+        if (rc == ODHS_OK) return;
+    }
+    ck_abort_msg("no end");
+}
+
+/* rms minimum-image difference of two final configurations (2D, the same
+ * box, both at the same strain) */
+static double rms_diff(const odhs_system *ref, const double *a, const double *b)
+{
+    size_t n = odhs_system_count(ref);
+    double L[2], s = 0.0;
+    odhs_system_get_box(ref, L);
+    for (size_t i = 0; i < n; ++i) {
+        double dx = a[2 * i] - b[2 * i], dy = a[2 * i + 1] - b[2 * i + 1];
+        dy -= nearbyint(dy / L[1]) * L[1];
+        dx -= nearbyint(dx / L[0]) * L[0];
+        s += dx * dx + dy * dy;
+    }
+    return sqrt(s / (double)n);
+}
+
+/* least-squares slope of log(err) against log(h) */
+static double order_of(const double *h, const double *err, int n)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int k = 0; k < n; ++k) {
+        double x = log(h[k]), y = log(err[k]);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+    }
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+/* Two discs pushed past each other (forces +-1 along x, offset 0.3 in y):
+ * free motion, a contact at tc = (2 - sqrt(0.91))/2 on which the pair
+ * turns as d(theta)/dt = 2 sin(theta), tan(theta/2) = tan(theta0/2)
+ * e^{2 (t - tc)}, and an opening at theta = pi/2. With the step held at dt
+ * (tol near 1), the positions at T = 1.2 converge to the analytic ones at
+ * first order; the collision and the opening are reported at the end of
+ * the step that holds them. */
+START_TEST(test_two_discs_first_order)
+{
+    const double tc = (2.0 - sqrt(0.91)) / 2.0, th0 = asin(0.3), T = 1.2;
+    const double topen = tc + 0.5 * log(1.0 / tan(0.5 * th0));
+    const double th = 2.0 * atan(tan(0.5 * th0) * exp(2.0 * (T - tc)));
+    const double xe[4] = {4.0 - 0.5 * cos(th), 5.15 - 0.5 * sin(th), 4.0 + 0.5 * cos(th), 5.15 + 0.5 * sin(th)};
+    const double dts[4] = {2e-2, 1e-2, 5e-3, 2.5e-3};
+    double err[4];
+    for (int q = 0; q < 4; ++q) {
+        double L[2] = {10, 10}, r[2] = {0.5, 0.5}, x[4] = {3.0, 5.0, 5.0, 5.3}, F[4] = {1.0, 0.0, -1.0, 0.0};
+        bscene s;
+        ck_assert_int_eq(odhs_system_create(2, 2, &s.sys), ODHS_OK);
+        ck_assert_int_eq(odhs_system_set_configuration(s.sys, L, 0.0, r, x), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_create(&s.drv), ODHS_OK);
+        ck_assert_int_eq(odhs_driver_set_forces(s.drv, 2, 2, F), ODHS_OK);
+        ck_assert_int_eq(odhs_solver_create_by_name("dense", &s.sol), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_create(s.sys, s.drv, s.sol, &s.st), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_integrator(s.st, ODHS_INTEGRATOR_BATCHED), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_dt(s.st, dts[q]), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_set_tolerance(s.st, 0.999), ODHS_OK);
+        double tcol = -1, topn = -1, t = 0;
+        while (t < T) {
+            odhs_step_info info;
+            memset(&info, 0, sizeof info);
+            info.size = sizeof info;
+            ck_assert_int_eq(odhs_stepper_step_ex(s.st, &info), ODHS_OK);
+            if (info.collisions && tcol < 0) tcol = info.time_end;
+            ck_assert_uint_eq(info.openings, 0);
+            /* held at dt (up to the last step, cut at T below) */
+            ck_assert_msg(fabs(info.time_end - info.time_start - dts[q]) <= 1e-12, "step %g",
+                          info.time_end - info.time_start);
+            t = info.time_end;
+            if (t + dts[q] > T) break;
+        }
+        ck_assert_int_eq(odhs_stepper_run_until_time(s.st, T), ODHS_OK);
+        /* reported at the end of the step that holds it */
+        ck_assert_msg(tcol >= tc && tcol <= tc + dts[q] * (1 + 1e-9), "collision at %.6f, exact %.6f (dt %g)", tcol,
+                      tc, dts[q]);
+        double xg[4];
+        ck_assert_int_eq(odhs_system_get_positions(s.sys, xg), ODHS_OK);
+        double e = 0;
+        for (int k = 0; k < 4; ++k) e = fmax(e, fabs(xg[k] - xe[k]));
+        err[q] = e;
+        /* on to the opening */
+        while (topn < 0 && t < 3.0) {
+            odhs_step_info info;
+            memset(&info, 0, sizeof info);
+            info.size = sizeof info;
+            ck_assert_int_eq(odhs_stepper_step_ex(s.st, &info), ODHS_OK);
+            if (info.openings) topn = info.time_end;
+            t = info.time_end;
+        }
+        fprintf(stderr, "[batched] two discs dt %.1e: collision at %.6f (exact %.6f), opening at %.6f (exact %.6f), "
+                        "position error at T = %.1f: %.3e\n",
+                dts[q], tcol, tc, topn, topen, T, err[q]);
+        /* the opening: first order too, within a few steps */
+        ck_assert_msg(fabs(topn - topen) <= 4.0 * dts[q], "opening at %.6f, exact %.6f", topn, topen);
+        bscene_free(&s);
+    }
+    double p = order_of(dts, err, 4);
+    fprintf(stderr, "[batched] two discs: order %.2f\n", p);
+    ck_assert_msg(p > 0.8 && p < 1.3, "order %.3f, expected 1", p);
+    for (int q = 1; q < 4; ++q) ck_assert_msg(err[q] < 0.7 * err[q - 1], "errors %g %g", err[q - 1], err[q]);
+}
+END_TEST
+
+/* 2D shear, N = 48 at phi = 0.78: from one start, over strain 0.01, the
+ * batched trajectory converges to the exact one (Heun at tol 1e-12) as
+ * the step falls, at first order; no overlap, no negative force and power
+ * balance after every step. */
+START_TEST(test_shear_converges)
+{
+    const size_t n = 48;
+    const double gamma = 0.01;
+    odhs_system *start = packing(2, n, 0.78, 5);
+    double *xr = malloc(2 * n * sizeof *xr), *x = malloc(2 * n * sizeof *x);
+    bscene s;
+    worst w;
+    sheared(&s, start, 1.0, 0, ODHS_INTEGRATOR_HEUN, 1e-2, 1e-12);
+    ck_assert_int_eq(odhs_stepper_run_until_strain(s.st, gamma), ODHS_OK);
+    ck_assert_int_eq(odhs_system_get_positions(s.sys, xr), ODHS_OK);
+    uint64_t ev;
+    ck_assert_int_eq(odhs_stepper_counts(s.st, NULL, &ev, NULL), ODHS_OK);
+    ck_assert_msg(ev >= 3, "%llu collisions: too few to test", (unsigned long long)ev);
+    bscene_free(&s);
+    const double dts[4] = {2e-3, 1e-3, 5e-4, 2.5e-4};
+    double err[4];
+    for (int q = 0; q < 4; ++q) {
+        sheared(&s, start, 1.0, 0, ODHS_INTEGRATOR_BATCHED, dts[q], 0.999);
+        run_checked(s.st, gamma, &w);
+        ck_assert_int_eq(odhs_system_get_positions(s.sys, x), ODHS_OK);
+        err[q] = rms_diff(start, x, xr);
+        uint64_t nb, ne;
+        ck_assert_int_eq(odhs_stepper_batched_stats(s.st, &nb, &ne, NULL), ODHS_OK);
+        fprintf(stderr,
+                "[batched] shear N = %zu dt %.1e: %zu steps (%llu batched, %llu exact), rms error %.3e; worst "
+                "overlap %.1e, contact gap %.1e, negative force %.1e, power %.1e\n",
+                n, dts[q], w.steps, (unsigned long long)nb, (unsigned long long)ne, err[q], w.overlap, w.gap,
+                w.negative, w.power);
+        ck_assert_msg(nb > 0, "no batched step");
+        ck_assert_msg(w.overlap <= 1e-12, "overlap %g", w.overlap);
+        ck_assert_msg(w.gap <= 1e-12, "contact gap %g", w.gap);
+        ck_assert_msg(w.negative <= 1e-12, "negative force %g", w.negative);
+        ck_assert_msg(w.power <= 1e-10, "power balance %g", w.power);
+        bscene_free(&s);
+    }
+    double p = order_of(dts, err, 4);
+    fprintf(stderr, "[batched] shear: order %.2f\n", p);
+    ck_assert_msg(p > 0.7, "order %.3f, expected about 1", p);
+    ck_assert_msg(err[3] < 0.25 * err[0], "errors %g -> %g", err[0], err[3]);
+    free(xr);
+    free(x);
+    odhs_system_destroy(start);
+}
+END_TEST
+
+/* the invariants after every step at the default tolerance, with a step
+ * that batches several events: 2D and 3D, fixed volume and fixed pressure */
+static void invariants_case(int dim, double p)
+{
+    odhs_system *start = packing(dim, dim == 2 ? 64 : 54, dim == 2 ? 0.80 : 0.60, 7);
+    bscene s;
+    worst w;
+    sheared(&s, start, 1.0, p, ODHS_INTEGRATOR_BATCHED, 1e-2, 0);
+    run_checked(s.st, 0.1, &w);
+    uint64_t nb, ne, coll;
+    ck_assert_int_eq(odhs_stepper_batched_stats(s.st, &nb, &ne, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_counts(s.st, NULL, &coll, NULL), ODHS_OK);
+    fprintf(stderr,
+            "[batched] %dD p = %g: %zu steps (%llu batched, %llu exact), %llu collisions; worst overlap %.1e, "
+            "contact gap %.1e, negative force %.1e, power %.1e\n",
+            dim, p, w.steps, (unsigned long long)nb, (unsigned long long)ne, (unsigned long long)coll, w.overlap,
+            w.gap, w.negative, w.power);
+    ck_assert_msg(nb > ne, "batched %llu, exact %llu", (unsigned long long)nb, (unsigned long long)ne);
+    ck_assert_msg(coll > w.steps, "%llu collisions in %zu steps: no batching", (unsigned long long)coll, w.steps);
+    ck_assert_msg(w.overlap <= 1e-12, "overlap %g", w.overlap);
+    ck_assert_msg(w.negative <= 1e-12, "negative force %g", w.negative);
+    ck_assert_msg(w.power <= 1e-10, "power balance %g", w.power);
+    if (p == 0) ck_assert_msg(w.gap <= 1e-12, "contact gap %g", w.gap);
+    bscene_free(&s);
+    odhs_system_destroy(start);
+}
+
+START_TEST(test_invariants_2d) { invariants_case(2, 0.0); }
+END_TEST
+
+START_TEST(test_invariants_3d) { invariants_case(3, 0.0); }
+END_TEST
+
+START_TEST(test_invariants_pressure_2d) { invariants_case(2, 10.0); }
+END_TEST
+
+/* rigid dimers made of touching pairs in a sheared packing: the bonds
+ * hold their lengths, no bead pair of a dimer collides, and the other
+ * invariants hold after every step */
+START_TEST(test_invariants_dimers)
+{
+    odhs_system *start = packing(2, 64, 0.78, 13);
+    bscene s;
+    worst w;
+    sheared(&s, start, 1.0, 0, ODHS_INTEGRATOR_BATCHED, 1e-2, 0);
+    ck_assert_int_eq(odhs_stepper_reset(s.st), ODHS_OK);
+    size_t nc, ci[512], cj[512];
+    ck_assert_int_eq(odhs_stepper_contacts(s.st, 512, &nc, ci, cj, NULL, NULL, NULL), ODHS_OK);
+    unsigned char used[64] = {0};
+    size_t nb = 0;
+    for (size_t c = 0; c < nc && nb < 12; ++c) {
+        if (used[ci[c]] || used[cj[c]]) continue;
+        size_t beads[2] = {ci[c], cj[c]};
+        ck_assert_int_eq(odhs_stepper_add_rigid_body(s.st, 2, beads), ODHS_OK);
+        used[ci[c]] = used[cj[c]] = 1;
+        nb++;
+    }
+    ck_assert_uint_ge(nb, 6);
+    run_checked(s.st, 0.1, &w);
+    uint64_t nbs, ne, coll;
+    ck_assert_int_eq(odhs_stepper_batched_stats(s.st, &nbs, &ne, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_counts(s.st, NULL, &coll, NULL), ODHS_OK);
+    fprintf(stderr,
+            "[batched] %zu dimers: %zu steps (%llu batched, %llu exact), %llu collisions; worst overlap %.1e, "
+            "contact gap %.1e, negative force %.1e, power %.1e\n",
+            nb, w.steps, (unsigned long long)nbs, (unsigned long long)ne, (unsigned long long)coll, w.overlap, w.gap,
+            w.negative, w.power);
+    ck_assert_msg(nbs > ne && coll > 0, "batched %llu, exact %llu, collisions %llu", (unsigned long long)nbs,
+                  (unsigned long long)ne, (unsigned long long)coll);
+    ck_assert_msg(w.overlap <= 1e-12 && w.gap <= 1e-12, "overlap %g, gap (bonds too) %g", w.overlap, w.gap);
+    ck_assert_msg(w.negative <= 1e-12 && w.power <= 1e-10, "negative force %g, power %g", w.negative, w.power);
+    bscene_free(&s);
+    odhs_system_destroy(start);
+}
+END_TEST
+
+/* a piston (a plane wall moving down at speed 1) compresses 40 discs onto
+ * a floor: collisions with the walls batched too, no overlap with them */
+START_TEST(test_invariants_piston)
+{
+    enum { NP = 40 };
+    double L[2] = {12, 30}, r[NP], x[2 * NP];
+    for (int k = 0; k < NP; ++k) {
+        r[k] = k % 2 ? 0.7 : 0.5;
+        x[2 * k] = 1.0 + 2.0 * (k % 6) + 0.3 * ((k / 6) % 2);
+        x[2 * k + 1] = 3.0 + 2.5 * (k / 6);
+    }
+    bscene s;
+    ck_assert_int_eq(odhs_system_create(2, NP, &s.sys), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_configuration(s.sys, L, 0.0, r, x), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&s.drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_time_unit(s.drv, 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &s.sol), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(s.sys, s.drv, s.sol, &s.st), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_integrator(s.st, ODHS_INTEGRATOR_BATCHED), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_dt(s.st, 2e-2), ODHS_OK);
+    double up[2] = {0.0, 1.0}, down[2] = {0.0, -1.0}, v[2] = {0.0, -1.0};
+    size_t piston;
+    ck_assert_int_eq(odhs_stepper_add_wall_plane(s.st, up, 1.0, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_add_wall_plane(s.st, down, -20.0, &piston), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_wall_velocity(s.st, piston, v), ODHS_OK);
+    worst w;
+    memset(&w, 0, sizeof w);
+    size_t wall_contacts = 0;
+    for (double t = 0.0; t < 6.0;) {
+        ck_assert_int_eq(odhs_stepper_step(s.st, NULL), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_time(s.st, &t), ODHS_OK);
+        invariants(s.st, &w);
+        double ov;
+        ck_assert_int_eq(odhs_stepper_errors(s.st, NULL, &ov), ODHS_OK);
+        w.overlap = fmax(w.overlap, ov);
+        size_t nc, ci[256], cj[256];
+        int kind[256];
+        ck_assert_int_eq(odhs_stepper_contacts(s.st, 256, &nc, ci, cj, kind, NULL, NULL), ODHS_OK);
+        size_t nw = 0;
+        for (size_t c = 0; c < nc; ++c) nw += kind[c] == ODHS_CONTACT_WALL;
+        wall_contacts = wall_contacts > nw ? wall_contacts : nw;
+    }
+    uint64_t nbs, ne, coll;
+    ck_assert_int_eq(odhs_stepper_batched_stats(s.st, &nbs, &ne, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_counts(s.st, NULL, &coll, NULL), ODHS_OK);
+    fprintf(stderr,
+            "[batched] piston: %zu steps (%llu batched, %llu exact), %llu collisions, up to %zu wall contacts; worst "
+            "overlap %.1e, contact gap %.1e, negative force %.1e, power %.1e\n",
+            w.steps, (unsigned long long)nbs, (unsigned long long)ne, (unsigned long long)coll, wall_contacts,
+            w.overlap, w.gap, w.negative, w.power);
+    ck_assert_msg(nbs > ne && wall_contacts >= 4, "batched %llu, exact %llu, wall contacts %zu",
+                  (unsigned long long)nbs, (unsigned long long)ne, wall_contacts);
+    ck_assert_msg(w.overlap <= 1e-12 && w.gap <= 1e-12, "overlap %g, gap %g", w.overlap, w.gap);
+    ck_assert_msg(w.negative <= 1e-12 && w.power <= 1e-10, "negative force %g, power %g", w.negative, w.power);
+    bscene_free(&s);
+}
+END_TEST
+
+/* gammadot = 1e-8 and 1e8 give the trajectory of gammadot = 1 in strain */
+START_TEST(test_rate_invariance)
+{
+    odhs_system *start = packing(2, 64, 0.80, 9);
+    const double gd[3] = {1.0, 1e-8, 1e8};
+    size_t n = 64;
+    double *x[3];
+    uint64_t coll[3];
+    for (int q = 0; q < 3; ++q) {
+        bscene s;
+        x[q] = malloc(2 * n * sizeof *x[q]);
+        sheared(&s, start, gd[q], 0, ODHS_INTEGRATOR_BATCHED, 1e-2, 0);
+        ck_assert_int_eq(odhs_stepper_run_until_strain(s.st, 0.05), ODHS_OK);
+        ck_assert_int_eq(odhs_system_get_positions(s.sys, x[q]), ODHS_OK);
+        ck_assert_int_eq(odhs_stepper_counts(s.st, NULL, &coll[q], NULL), ODHS_OK);
+        double t;
+        ck_assert_int_eq(odhs_stepper_time(s.st, &t), ODHS_OK);
+        ck_assert_msg(fabs(t * gd[q] - 0.05) <= 1e-12, "time %.17g at gammadot %g", t, gd[q]);
+        bscene_free(&s);
+    }
+    ck_assert_msg(coll[0] > 0, "no collisions: vacuous");
+    for (int q = 1; q < 3; ++q) {
+        double d = rms_diff(start, x[0], x[q]);
+        fprintf(stderr, "[batched] rate invariance x %.0e: rms position difference %.2e, collisions %llu / %llu\n",
+                gd[q], d, (unsigned long long)coll[q], (unsigned long long)coll[0]);
+        ck_assert_msg(d <= 1e-9, "gammadot %g: positions differ by %g", gd[q], d);
+        ck_assert_uint_eq(coll[q], coll[0]);
+    }
+    for (int q = 0; q < 3; ++q) free(x[q]);
+    odhs_system_destroy(start);
+}
+END_TEST
+
+/* defaults: tol 1e-3 with the batched integrator unless a tolerance was
+ * set; counters; the pre-event stress has no record for a batched step */
+START_TEST(test_settings)
+{
+    odhs_system *start = packing(2, 32, 0.78, 11);
+    bscene s;
+    int integ;
+    double tol;
+    sheared(&s, start, 1.0, 0, ODHS_INTEGRATOR_BATCHED, 1e-2, 0);
+    ck_assert_int_eq(odhs_stepper_get_settings(s.st, &integ, NULL, &tol, NULL), ODHS_OK);
+    ck_assert(integ == ODHS_INTEGRATOR_BATCHED && tol == 1e-3);
+    ck_assert_int_eq(odhs_stepper_set_integrator(s.st, ODHS_INTEGRATOR_HEUN), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_get_settings(s.st, NULL, NULL, &tol, NULL), ODHS_OK);
+    ck_assert(tol == 1e-6);
+    ck_assert_int_eq(odhs_stepper_set_tolerance(s.st, 1e-4), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_integrator(s.st, ODHS_INTEGRATOR_BATCHED), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_get_settings(s.st, NULL, NULL, &tol, NULL), ODHS_OK);
+    ck_assert(tol == 1e-4);
+    uint64_t nb = 7, ne = 7, nv = 7;
+    ck_assert_int_eq(odhs_stepper_batched_stats(s.st, &nb, &ne, &nv), ODHS_OK);
+    ck_assert(nb == 0 && ne == 0 && nv == 0);
+    ck_assert_int_eq(odhs_stepper_set_pre_event_stress(s.st, 1), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_step(s.st, NULL), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_batched_stats(s.st, &nb, NULL, &nv), ODHS_OK);
+    ck_assert(nb == 1 && nv >= 1);
+    double sig[4];
+    ck_assert_int_eq(odhs_stepper_pre_event_stress(s.st, sig), ODHS_E_STATE);
+    ck_assert_msg(strstr(odhs_stepper_errmsg(s.st), "batched") != NULL, "%s", odhs_stepper_errmsg(s.st));
+    ck_assert_int_eq(odhs_stepper_batched_stats(NULL, &nb, NULL, NULL), ODHS_E_NULL);
+    bscene_free(&s);
+    odhs_system_destroy(start);
+}
+END_TEST
+
+Suite *make_batched_suite(void)
+{
+    Suite *s = suite_create("batched");
+    TCase *tc = tcase_create("core");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, test_settings);
+    tcase_add_test(tc, test_two_discs_first_order);
+    tcase_add_test(tc, test_shear_converges);
+    tcase_add_test(tc, test_invariants_2d);
+    tcase_add_test(tc, test_invariants_3d);
+    tcase_add_test(tc, test_invariants_pressure_2d);
+    tcase_add_test(tc, test_invariants_dimers);
+    tcase_add_test(tc, test_invariants_piston);
+    tcase_add_test(tc, test_rate_invariance);
+    suite_add_tcase(s, tc);
+    return s;
+}
