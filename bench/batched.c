@@ -7,21 +7,26 @@
  * (solver auto), drift correction. Above NBUILD (default 16384) the start is
  * a periodic 2^d tiling of the packing of N / 2^d (repeated): the copies
  * start identical and part by round-off and chaos under shear.
- * Warm-up: shear at rate 1 to strain 0.05 with the batched integrator (not
+ * Warm-up: shear at rate 1 to strain 0.3 with the batched integrator (not
  * timed). Then from that state, each setting in its own process (its peak
  * resident set size is its memory):
  *   exact      the library's defaults (adaptive Heun, tol 1e-6), solver auto,
  *              over the strain that holds EVENTS events (default 1000; from
  *              the warm-up's event rate); skipped above EXACT_NMAX
- *   batched    ODHS_INTEGRATOR_BATCHED at its default tolerance (1e-3), dt
- *              1e-3 (the library's), over strain 0.05 (at least 50 steps)
+ *   batched    ODHS_INTEGRATOR_BATCHED with its defaults (tol 1e-3, dt 5e-2:
+ *              steps set by the tolerance), over strain 0.3
  *   tight      the same at tol 1e-4
  * Cost per unit strain = CPU seconds of the process / strain. Fitted
  * exponents (least squares of log cost on log N) and an SVG plot.
  *
  * usage: batched [DIM] [NLIST] [SVG] [EXACT_NMAX] [EVENTS] [NBUILD]
  *        defaults 2  1024,4096,16384,65536  batched_2d.svg  16384  1000  16384
- *        batched --memory DIM N: a few batched steps at N (tiled), peak RSS
+ *        batched --memory DIM N [NBUILD [STEPS]]: STEPS (default 5) batched
+ *          steps at N (tiled from N / 2^DIM ... down to NBUILD), peak RSS
+ *        batched --accuracy DIM N SEEDS STRAIN: steady-state sxy, p, z and
+ *          collisions per unit strain of exact and batched runs (block
+ *          means, SEEDS starts, over STRAIN each), and the convergence of
+ *          a trajectory over strain 0.01 as the tolerance and the step fall
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -39,6 +44,8 @@
 #include "../examples/plot.h"
 
 enum { S_EXACT, S_BATCHED, S_TIGHT, S_COUNT };
+#define WARMUP 0.3 /* strain of the warm-up (batched) */
+#define WINDOW 0.3 /* strain of a batched run */
 static const char *const sname[S_COUNT] = {"exact (defaults)", "batched tol 1e-3", "batched tol 1e-4"};
 
 typedef struct {
@@ -49,15 +56,15 @@ typedef struct {
 } run_result;
 
 /* a packing of n particles at phi by batched compression */
-static int compress(int dim, size_t n, double phi, odhs_system **out)
+static int compress_seed(int dim, size_t n, double phi, unsigned seed, odhs_system **out)
 {
     odhs_system *sys;
     odhs_solver *sol = NULL;
     odhs_driver *drv = NULL;
     odhs_stepper *st = NULL;
     int rc = odhs_system_create(dim, n, &sys);
-    if (!rc) rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, (unsigned)(11 + n));
-    if (!rc) rc = odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.30, (unsigned)(12 + n));
+    if (!rc) rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed);
+    if (!rc) rc = odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.30, seed + 1);
     if (!rc) rc = odhs_solver_create_by_name("auto", &sol);
     if (!rc) rc = odhs_driver_create(&drv);
     if (!rc) rc = odhs_driver_set_compression_rate(drv, 1.0);
@@ -72,6 +79,11 @@ static int compress(int dim, size_t n, double phi, odhs_system **out)
     if (rc) odhs_system_destroy(sys);
     else *out = sys;
     return rc;
+}
+
+static int compress(int dim, size_t n, double phi, odhs_system **out)
+{
+    return compress_seed(dim, n, phi, (unsigned)(11 + n), out);
 }
 
 /* 2^dim periodic tiling of an unsheared box */
@@ -201,11 +213,11 @@ static void build_child(void *arg, void *out)
     odhs_driver *drv;
     odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
     b->rc = odhs_stepper_reset(st);
-    if (!b->rc) b->rc = odhs_stepper_run_until_strain(st, 0.05);
+    if (!b->rc) b->rc = odhs_stepper_run_until_strain(st, WARMUP);
     if (!b->rc) b->rc = odhs_stepper_correct(st);
     uint64_t co = 0, op = 0;
     odhs_stepper_counts(st, NULL, &co, &op);
-    b->events_per_strain = (double)(co + op) / 0.05;
+    b->events_per_strain = (double)(co + op) / WARMUP;
     b->nc = odhs_network_count(odhs_stepper_network(st));
     odhs_system_packing_fraction(sys, &b->phi);
     if (!b->rc) b->rc = odhs_checkpoint_write(st, j->path);
@@ -240,7 +252,7 @@ static void run_child(void *arg, void *out)
 }
 
 /* --memory: a few batched steps at N */
-static int memory(int dim, size_t n, size_t nbuild)
+static int memory(int dim, size_t n, size_t nbuild, int nsteps)
 {
     odhs_system *sys;
     double t0 = bench_wall();
@@ -250,14 +262,28 @@ static int memory(int dim, size_t n, size_t nbuild)
     odhs_driver *drv;
     odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
     int rc = odhs_stepper_reset(st);
-    for (int k = 0; k < 5 && !rc; ++k) rc = odhs_stepper_step(st, NULL);
+    double cs = bench_cpu();
+    {
+        struct rusage r0;
+        getrusage(RUSAGE_SELF, &r0);
+        printf("# %dD N = %zu: start built in %.0f s wall, reset: status %d, peak RSS %.1f MiB\n", dim, n, tb, rc,
+               r0.ru_maxrss / 1024.0);
+        fflush(stdout);
+    }
+    for (int k = 0; k < nsteps && !rc; ++k) {
+        rc = odhs_stepper_step(st, NULL);
+        struct rusage rk;
+        getrusage(RUSAGE_SELF, &rk);
+        printf("# step %d: status %d, %.1f CPU s, peak RSS %.1f MiB\n", k + 1, rc, bench_cpu() - cs, rk.ru_maxrss / 1024.0);
+        fflush(stdout);
+    }
     uint64_t co = 0;
     odhs_stepper_counts(st, NULL, &co, NULL);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    printf("# memory: %dD N = %zu (start %.0f s wall), 5 batched steps: status %d (%s), %llu collisions, %.1f CPU s, "
+    printf("# memory: %dD N = %zu (start %.0f s wall), %d batched steps: status %d (%s), %llu collisions, %.1f CPU s, "
            "peak RSS %.1f MiB\n",
-           dim, n, tb, rc, rc ? odhs_stepper_errmsg(st) : "ok", (unsigned long long)co, bench_cpu() - c0,
+           dim, n, tb, nsteps, rc, rc ? odhs_stepper_errmsg(st) : "ok", (unsigned long long)co, bench_cpu() - c0,
            ru.ru_maxrss / 1024.0);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
@@ -266,10 +292,219 @@ static int memory(int dim, size_t n, size_t nbuild)
     return rc != 0;
 }
 
+
+/* ---- --accuracy: steady-state statistics and convergence ------------------ */
+typedef struct {
+    double mean[4], err[4]; /* sxy, p, z, collisions per unit strain */
+    double cpu;
+    uint64_t steps;
+} stats;
+
+/* shear sys over strain w, sampling sxy, p, z every 0.01 and collisions per
+ * block; block means (nb blocks) -> mean and standard error */
+static int sample_run(odhs_system *sys, int setting, double w, int nb, stats *out)
+{
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st = shear_stepper(sys, setting, &sol, &drv);
+    memset(out, 0, sizeof *out);
+    double blk[64][4];
+    int ns = (int)lround(w / 0.01), per = ns / nb, rc = odhs_stepper_reset(st);
+    double c0 = bench_cpu(), g0 = 0.0;
+    uint64_t col0 = 0;
+    odhs_stepper_strain(st, &g0);
+    odhs_stepper_counts(st, NULL, &col0, NULL);
+    for (int b = 0; b < nb && !rc; ++b) {
+        double acc[3] = {0, 0, 0};
+        for (int k = 0; k < per && !rc; ++k) {
+            rc = odhs_stepper_run_until_strain(st, g0 + 0.01 * (b * per + k + 1));
+            double v[3];
+            odhs_stepper_shear_stress(st, &v[0]);
+            odhs_stepper_pressure(st, &v[1]);
+            odhs_stepper_coordination(st, &v[2]);
+            for (int a = 0; a < 3; ++a) acc[a] += v[a] / per;
+        }
+        uint64_t col;
+        odhs_stepper_counts(st, NULL, &col, NULL);
+        for (int a = 0; a < 3; ++a) blk[b][a] = acc[a];
+        blk[b][3] = (double)(col - col0) / (0.01 * per);
+        col0 = col;
+    }
+    out->cpu = bench_cpu() - c0;
+    odhs_stepper_counts(st, &out->steps, NULL, NULL);
+    for (int a = 0; a < 4; ++a) {
+        double m = 0, v = 0;
+        for (int b = 0; b < nb; ++b) m += blk[b][a] / nb;
+        for (int b = 0; b < nb; ++b) v += (blk[b][a] - m) * (blk[b][a] - m);
+        out->mean[a] = m;
+        out->err[a] = sqrt(v / ((double)nb * (nb - 1)));
+    }
+    if (rc) fprintf(stderr, "batched: %s failed: %s\n", sname[setting], odhs_stepper_errmsg(st));
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    return rc;
+}
+
+/* rms minimum-image difference of positions a, b (same box, sheared) */
+static double rms_diff(const odhs_system *sys, const double *a, const double *b)
+{
+    int dim = odhs_system_dim(sys);
+    size_t n = odhs_system_count(sys);
+    double L[3] = {1, 1, 1}, g = 0.0, s = 0.0;
+    odhs_system_get_box(sys, L);
+    odhs_system_get_strain(sys, &g);
+    for (size_t i = 0; i < n; ++i) {
+        double d[3] = {0, 0, 0};
+        for (int k = 0; k < dim; ++k) d[k] = a[i * dim + k] - b[i * dim + k];
+        double ny = nearbyint(d[1] / L[1]);
+        d[1] -= ny * L[1];
+        d[0] -= ny * g * L[1];
+        for (int k = 0; k < dim; ++k)
+            if (k != 1) d[k] -= nearbyint(d[k] / L[k]) * L[k];
+        for (int k = 0; k < dim; ++k) s += d[k] * d[k];
+    }
+    return sqrt(s / (double)n);
+}
+
+/* positions after strain w from start with integrator/tol (tol 0: default) */
+static int trajectory(const odhs_system *start, int integ, double tol, double dt, double w, double *x, double *cpu,
+                      uint64_t *steps)
+{
+    odhs_system *sys;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st;
+    if (odhs_system_clone(start, &sys)) return 1;
+    odhs_solver_create_by_name("auto", &sol);
+    odhs_driver_create(&drv);
+    odhs_driver_set_shear_rate(drv, 1.0);
+    int rc = odhs_stepper_create(sys, drv, sol, &st);
+    if (!rc) rc = odhs_stepper_set_integrator(st, integ);
+    if (!rc && tol > 0) rc = odhs_stepper_set_tolerance(st, tol);
+    if (!rc && dt > 0) rc = odhs_stepper_set_dt(st, dt);
+    double c0 = bench_cpu();
+    if (!rc) rc = odhs_stepper_run_until_strain(st, w);
+    *cpu = bench_cpu() - c0;
+    odhs_stepper_counts(st, steps, NULL, NULL);
+    if (!rc) rc = odhs_system_get_positions(sys, x);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(sys);
+    return rc;
+}
+
+static int accuracy(int dim, size_t n, int seeds, double w)
+{
+    double phi = dim == 2 ? 0.80 : 0.60;
+    printf("# accuracy of the batched integrator, %dD N = %zu, phi = %.2f, shear rate 1, solver auto; libodhs %s\n", dim,
+           n, phi, odhs_version_string());
+    printf("# (a) steady state: per seed, batched compression, warm-up to strain 1 (batched), then each setting over "
+           "strain %g from that state; 10 block means -> mean +- standard error\n",
+           w);
+    printf("%4s %-17s %8s %9s %18s %18s %16s %20s\n", "seed", "setting", "steps", "cpu_s", "sxy", "p", "z",
+           "collisions/strain");
+    double pool[S_COUNT][4][16];
+    int got[S_COUNT] = {0};
+    double *x0 = NULL;
+    odhs_system *first = NULL;
+    for (int k = 0; k < seeds; ++k) {
+        odhs_system *sys;
+        if (compress_seed(dim, n, phi, 101 + 7 * k, &sys)) return 1;
+        odhs_solver *sol;
+        odhs_driver *drv;
+        odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
+        int rc = odhs_stepper_reset(st);
+        if (!rc) rc = odhs_stepper_run_until_strain(st, 1.0);
+        if (!rc) rc = odhs_stepper_correct(st);
+        odhs_stepper_destroy(st);
+        odhs_driver_destroy(drv);
+        odhs_solver_destroy(sol);
+        if (rc) return 1;
+        if (k == 0) odhs_system_clone(sys, &first);
+        for (int s = 0; s < S_COUNT; ++s) {
+            odhs_system *c;
+            odhs_system_clone(sys, &c);
+            stats r;
+            if (!sample_run(c, s, w, 10, &r)) {
+                printf("%4d %-17s %8llu %9.1f %9.4f+-%7.4f %9.4f+-%7.4f %8.4f+-%6.4f %11.1f+-%7.1f\n", k,
+                       sname[s], (unsigned long long)r.steps, r.cpu, r.mean[0], r.err[0], r.mean[1], r.err[1],
+                       r.mean[2], r.err[2], r.mean[3], r.err[3]);
+                for (int a = 0; a < 4; ++a) pool[s][a][got[s]] = r.mean[a];
+                got[s]++;
+            }
+            fflush(stdout);
+            odhs_system_destroy(c);
+        }
+        odhs_system_destroy(sys);
+    }
+    printf("# pooled over seeds (mean +- standard error of the seed means); difference to exact in units of the "
+           "combined error\n");
+    for (int s = 0; s < S_COUNT; ++s) {
+        if (got[s] < 2) continue;
+        printf("%-17s", sname[s]);
+        for (int a = 0; a < 4; ++a) {
+            double m[S_COUNT] = {0}, e[S_COUNT] = {0};
+            for (int q = 0; q < S_COUNT; ++q) {
+                if (got[q] < 2) continue;
+                for (int i = 0; i < got[q]; ++i) m[q] += pool[q][a][i] / got[q];
+                for (int i = 0; i < got[q]; ++i) e[q] += (pool[q][a][i] - m[q]) * (pool[q][a][i] - m[q]);
+                e[q] = sqrt(e[q] / ((double)got[q] * (got[q] - 1)));
+            }
+            double z = s == S_EXACT ? 0.0 : (m[s] - m[S_EXACT]) / sqrt(e[s] * e[s] + e[S_EXACT] * e[S_EXACT]);
+            printf("  %s %.4g+-%.2g (%+.1f sigma)", a == 0 ? "sxy" : a == 1 ? "p" : a == 2 ? "z" : "coll/strain", m[s],
+                   e[s], z);
+        }
+        printf("\n");
+    }
+    /* (b) convergence over strain 0.01 from the first seed's warmed-up state */
+    size_t nd = n * (size_t)dim;
+    double *xr = malloc(nd * sizeof *xr), *x = malloc(nd * sizeof *x), cpu;
+    x0 = xr;
+    uint64_t steps;
+    printf("# (b) trajectory over strain 0.01 from seed 0's state: rms position difference to Heun tol 1e-11 (mean "
+           "diameters)\n");
+    if (!first || trajectory(first, ODHS_INTEGRATOR_HEUN, 1e-11, 0, 0.01, xr, &cpu, &steps)) return 1;
+    printf("%-26s %8s %9s %12s %7s\n", "setting", "steps", "cpu_s", "rms_error", "order");
+    const double tols[5] = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6};
+    double prev = NAN, prevt = NAN;
+    for (int q = 0; q < 5; ++q) {
+        if (trajectory(first, ODHS_INTEGRATOR_BATCHED, tols[q], 0, 0.01, x, &cpu, &steps)) continue;
+        double e = rms_diff(first, x, xr) / 1.2; /* mean diameter 1.2 */
+        char ord[16] = "-";
+        if (isfinite(prev)) snprintf(ord, sizeof ord, "%.2f", log(prev / e) / log(prevt / tols[q]));
+        printf("batched tol %-14.0e %8llu %9.2f %12.3e %7s\n", tols[q], (unsigned long long)steps, cpu, e, ord);
+        prev = e;
+        prevt = tols[q];
+        fflush(stdout);
+    }
+    printf("# order: d log(error) / d log(tol); first order in h with h ~ tol^(1/2) gives 0.5 in tol\n");
+    const double dts[4] = {4e-3, 2e-3, 1e-3, 5e-4};
+    prev = NAN;
+    for (int q = 0; q < 4; ++q) {
+        if (trajectory(first, ODHS_INTEGRATOR_BATCHED, 0.999, dts[q], 0.01, x, &cpu, &steps)) continue;
+        double e = rms_diff(first, x, xr) / 1.2;
+        char ord[16] = "-";
+        if (isfinite(prev)) snprintf(ord, sizeof ord, "%.2f", log(prev / e) / log(2.0));
+        printf("batched fixed h = %-8.0e %8llu %9.2f %12.3e %7s\n", dts[q], (unsigned long long)steps, cpu, e, ord);
+        prev = e;
+        fflush(stdout);
+    }
+    printf("# order in h: log2(error(2h) / error(h))\n");
+    free(x0);
+    free(x);
+    odhs_system_destroy(first);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 5 && !strcmp(argv[1], "--accuracy"))
+        return accuracy(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]));
     if (argc > 3 && !strcmp(argv[1], "--memory"))
-        return memory(atoi(argv[2]), (size_t)atol(argv[3]), argc > 4 ? (size_t)atol(argv[4]) : 16384);
+        return memory(atoi(argv[2]), (size_t)atol(argv[3]), argc > 4 ? (size_t)atol(argv[4]) : 16384,
+                      argc > 5 ? atoi(argv[5]) : 5);
     int dim = argc > 1 ? atoi(argv[1]) : 2;
     size_t ns[16], nn = 0;
     {
@@ -295,10 +530,10 @@ int main(int argc, char **argv)
            dim, dim == 2 ? 0.80 : 0.60);
     printf("# machine: %s (%ld logical CPUs); libodhs %s; load average at the start %.2f %.2f %.2f\n", cpu,
            sysconf(_SC_NPROCESSORS_ONLN), odhs_version_string(), la[0], la[1], la[2]);
-    printf("# start: batched compression (tiled above N = %zu), warm-up to strain 0.05 (batched); solver auto\n",
+    printf("# start: batched compression (tiled above N = %zu), warm-up to strain 0.3 (batched); solver auto\n",
            nbuild);
     printf("# exact: library defaults over %g events (from the warm-up's rate), skipped above N = %zu; batched: "
-           "strain 0.05, dt 1e-3; every setting in its own process\n",
+           "strain 0.3, its defaults (dt 5e-2); every setting in its own process\n",
            events, exact_nmax);
     printf("%6s %6s %6s %-17s %9s %7s %8s %8s %9s %12s %11s %8s %7s %7s %6s %8s\n", "N", "Nc", "phi", "setting",
            "strain", "steps", "exact", "events", "cpu_s", "cpu_s/strain", "ev/strain", "speedup", "sxy", "p", "z",
@@ -321,7 +556,7 @@ int main(int argc, char **argv)
                 continue;
             }
             j.setting = s;
-            j.w = s == S_EXACT ? fmin(0.05, fmax(1e-4, events / fmax(b.events_per_strain, 1.0))) : 0.05;
+            j.w = s == S_EXACT ? fmin(WINDOW, fmax(1e-4, events / fmax(b.events_per_strain, 1.0))) : WINDOW;
             run_result r;
             if (in_child(run_child, &j, &r, sizeof r, &rss) || r.rc) {
                 printf("%6zu %6zu %6.4f %-17s failed (%d)\n", ns[q], b.nc, b.phi, sname[s], r.rc);
@@ -367,7 +602,7 @@ int main(int argc, char **argv)
         }
     }
     char note[300];
-    snprintf(note, sizeof note, "%.120s, %ld CPUs (load %.1f); exact over %g events, batched over strain 0.05", cpu,
+    snprintf(note, sizeof note, "%.120s, %ld CPUs (load %.1f); exact over %g events, batched over strain 0.3", cpu,
              sysconf(_SC_NPROCESSORS_ONLN), la[0], events);
     pl_note(&p, note);
     if (pl_write_svg(&p, svg)) fprintf(stderr, "batched: cannot write %s\n", svg);

@@ -173,7 +173,12 @@ static inline int cli_set_tolerance(odhs_stepper *st, double tol)
     return tol > 0.0 ? odhs_stepper_set_tolerance(st, tol) : ODHS_OK;
 }
 /* unit: what --dt and --every are measured in */
-#define CLI_DT(p, unit) CLI_OPT_DOUBLE("--dt", p, "X", "step in " unit, CLI_POSITIVE)
+/* 0 keeps the integrator's own default (odhs_stepper_set_dt) */
+#define CLI_DT(p, unit)                                                                                              \
+    CLI_OPT_DOUBLE("--dt", p, "X", "step (heun, batched: largest step) in " unit, CLI_POSITIVE,                     \
+                   .deftext = "the integrator's: 1e-3, 5e-2 batched")
+/* set the step given with --dt (0: the integrator's default) */
+static inline int cli_set_dt(odhs_stepper *st, double dt) { return dt > 0.0 ? odhs_stepper_set_dt(st, dt) : ODHS_OK; }
 #define CLI_EVERY(p, unit) CLI_OPT_DOUBLE("--every", p, "X", "output interval in " unit, CLI_POSITIVE)
 #define CLI_STRAIN(p) CLI_OPT_DOUBLE("--strain", p, "X", "total shear strain", CLI_POSITIVE)
 #define CLI_TIME(p) CLI_OPT_DOUBLE("--time", p, "X", "run length in units of tau", CLI_POSITIVE)

@@ -19,7 +19,7 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *series = NULL, *plot = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double phi_target = 0.80, every = 0.01, dt = 1e-3, tol = 0.0, traj_every = 0.0;
+    double phi_target = 0.80, every = 0.01, dt = 0.0, tol = 0.0, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
     int dim = 2, jam = 0, integrator = CLI_DEFAULT_INTEGRATOR, quiet = 0;
     const cli_opt opts[] = {
@@ -64,7 +64,7 @@ int main(int argc, char **argv)
     odhs_driver *drv;
     odhs_stepper *st;
     if (odhs_driver_create(&drv) || odhs_driver_set_compression_rate(drv, 1.0) ||
-        odhs_stepper_create(sys, drv, solver, &st) || odhs_stepper_set_dt(st, dt) ||
+        odhs_stepper_create(sys, drv, solver, &st) || cli_set_dt(st, dt) ||
         odhs_stepper_set_integrator(st, integrator) || cli_set_tolerance(st, tol)) {
         fprintf(stderr, "compress: setup failed\n");
         return 1;

@@ -26,7 +26,7 @@ static const char *const methods[] = {"events", "lp", "quench+lp", NULL};
 static int configure(odhs_stepper *st, int integrator, double dt, double tol, unsigned long corr)
 {
     int rc = odhs_stepper_set_integrator(st, integrator);
-    if (!rc) rc = odhs_stepper_set_dt(st, dt);
+    if (!rc) rc = cli_set_dt(st, dt);
     if (!rc && integrator != ODHS_INTEGRATOR_EULER) rc = cli_set_tolerance(st, tol);
     if (!rc) rc = odhs_stepper_set_correction_interval(st, (unsigned)corr);
     return rc;
@@ -93,7 +93,7 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double dt = 1e-3, max_strain = 20.0, tol = 0.0, p_jam = 0.0, traj_every = 0.01, trust = 0.1, quench_phi = 0.0;
+    double dt = 0.0, max_strain = 20.0, tol = 0.0, p_jam = 0.0, traj_every = 0.01, trust = 0.1, quench_phi = 0.0;
     int protocol = COMPRESS, method = EVENTS, integrator = CLI_DEFAULT_INTEGRATOR, dim = 2, quiet = 0;
     unsigned long corr = 1;
     unsigned long n = 256, seed = 1;

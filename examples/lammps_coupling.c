@@ -362,7 +362,7 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *series = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *dump = NULL, *write_data = NULL, *lmp_input = NULL, *lmp_log = NULL;
-    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 0.0, sync_tol = 1e-12;
+    double strain = 0.2, every = 0.01, dt = 0.0, pressure = 0.0, phi = 0.80, tol = 0.0, sync_tol = 1e-12;
     unsigned long n = 256, seed = 1;
     int dim = 2, integrator = CLI_DEFAULT_INTEGRATOR, quiet = 0;
     const cli_opt opts[] = {
@@ -442,7 +442,7 @@ int main(int argc, char **argv)
     CHECK(odhs_driver_set_shear_rate(drv, 1.0));
     if (pressure > 0) CHECK(odhs_driver_set_pressure(drv, pressure));
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
-    CHECK(odhs_stepper_set_dt(st, dt));
+    CHECK(cli_set_dt(st, dt));
     CHECK(odhs_stepper_set_integrator(st, integrator));
     CHECK(cli_set_tolerance(st, tol));
     if ((rc = odhs_stepper_reset(st))) {

@@ -135,7 +135,7 @@ int main(int argc, char **argv)
         CLI_TRAJ(&traj),
         CLI_TRAJ_EVERY(&traj_every, "tau"),
         CLI_TRAJ_CONTACTS(&traj_contacts),
-        CLI_DT(&dt, "units of tau"),
+        CLI_OPT_DOUBLE("--dt", &dt, "X", "step (heun, batched: largest step) in units of tau", CLI_POSITIVE),
         CLI_INTEGRATOR(&integrator),
         CLI_TOL(&tol),
         CLI_SOLVER(&solver_name),

@@ -254,7 +254,7 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *series = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL, *plot = NULL, *contacts = NULL;
-    double strain = 0.2, every = 0.01, dt = 1e-3, pressure = 0.0, phi = 0.80, tol = 0.0, traj_every = 0.0;
+    double strain = 0.2, every = 0.01, dt = 0.0, pressure = 0.0, phi = 0.80, tol = 0.0, traj_every = 0.0;
     unsigned long n = 256, seed = 1;
     int dim = 2, integrator = CLI_DEFAULT_INTEGRATOR, shape = 0, quiet = 0;
     const char *oscillate = NULL;
@@ -348,7 +348,7 @@ int main(int argc, char **argv)
     else CHECK(odhs_driver_set_shear_rate(drv, 1.0));
     if (pressure > 0) CHECK(odhs_driver_set_pressure(drv, pressure));
     CHECK(odhs_stepper_create(sys, drv, solver, &st));
-    CHECK(odhs_stepper_set_dt(st, dt));
+    CHECK(cli_set_dt(st, dt));
     CHECK(odhs_stepper_set_integrator(st, integrator));
     CHECK(cli_set_tolerance(st, tol));
     rc = odhs_stepper_reset(st);

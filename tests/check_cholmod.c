@@ -561,6 +561,23 @@ START_TEST(test_pcg_update_to_singular)
     ck_assert_int_eq(odhs_network_add(net, 0, 3, ODHS_CONTACT_TEMPORARY), ODHS_OK);
     ck_assert_int_eq(odhs_network_update_geometry(net, sys), ODHS_OK);
     ck_assert(cm_vs_dense(p, net, b, xs) < 1e-12); /* 5 contacts: still regular */
+    {
+        /* "update_max" 0: the same added contact costs a full
+         * factorisation instead of an update, with the same answer */
+        odhs_solver *q = cm_new(&odhs_solver_type_cholmod_pcg);
+        ck_assert_int_eq(odhs_solver_set_param(q, "update_max", 0.0), ODHS_OK);
+        ck_assert_int_eq(odhs_network_remove(net, 0, 3), ODHS_OK);
+        double xq[6] = {0};
+        ck_assert(cm_vs_dense(q, net, b, xq) < 1e-12);
+        ck_assert_int_eq(odhs_network_add(net, 0, 3, ODHS_CONTACT_TEMPORARY), ODHS_OK);
+        ck_assert_int_eq(odhs_network_update_geometry(net, sys), ODHS_OK);
+        memset(xq, 0, sizeof xq);
+        ck_assert(cm_vs_dense(q, net, b, xq) < 1e-12);
+        ck_assert_double_eq(cm_stat(q, "updates"), 0.0);
+        ck_assert_double_eq(cm_stat(q, "factorizations"), 2.0);
+        for (int k = 0; k < 5; ++k) ck_assert_double_eq_tol(xq[k], xs[k], 1e-12);
+        odhs_solver_destroy(q);
+    }
     /* 1-2 (not touching, but any pair may be a contact): 6 rows on 8 - 3 = 5
      * non-trivial degrees of freedom */
     ck_assert_double_eq(cm_stat(p, "updates"), 1.0);
@@ -725,6 +742,61 @@ START_TEST(test_pcg_updates_moving_3d)
 }
 END_TEST
 
+/* many insertions at once (update_max 1 lets them all through as updates):
+ * the free slots sit where the last analysis put them, and the fill they
+ * make is bounded while the insertions run (the factor's allocation beyond
+ * 2.5 times the fresh one's stops them and setup refactors) */
+START_TEST(test_pcg_bulk_insertions)
+{
+    cm_case c = cm_random_case(2, 1500, 65, 0);
+    tu_rng rng;
+    tu_rng_seed(&rng, 66);
+    size_t nmax = c.nc + c.nc / 8 + 1;
+    double *b = malloc(nmax * sizeof *b), *x = calloc(nmax, sizeof *x);
+    ck_assert(b && x);
+    odhs_solver *p = cm_new(&odhs_solver_type_cholmod_pcg);
+    ck_assert_int_eq(odhs_solver_set_param(p, "refactor_every", 0.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(p, "update_max", 1.0), ODHS_OK);
+    cm_rhs(c.net, &rng, b);
+    ck_assert(cm_vs_dense(p, c.net, b, x) < 1e-10);
+    double nnz0 = cm_stat(p, "nnz_L");
+    /* swap nc/9 contacts for pool pairs that were not in the network */
+    size_t k = c.nc / 9, added = 0;
+    size_t *gone = malloc(2 * k * sizeof *gone);
+    ck_assert_ptr_nonnull(gone);
+    for (size_t r = 0; r < k; ++r) {
+        size_t q = tu_index(&rng, odhs_network_count(c.net));
+        ck_assert_int_eq(odhs_network_get_contact(c.net, q, &gone[2 * r], &gone[2 * r + 1], NULL), ODHS_OK);
+        ck_assert_int_eq(odhs_network_remove(c.net, gone[2 * r], gone[2 * r + 1]), ODHS_OK);
+    }
+    for (size_t q = 0; q < c.pool.n && added < k; ++q) {
+        size_t idx, i = c.pool.p[q].i, j = c.pool.p[q].j, was = 0;
+        for (size_t r = 0; r < k; ++r)
+            was |= (gone[2 * r] == i && gone[2 * r + 1] == j) || (gone[2 * r] == j && gone[2 * r + 1] == i);
+        ck_assert_int_eq(odhs_network_find(c.net, i, j, &idx), ODHS_OK);
+        if (idx != SIZE_MAX || was) continue;
+        ck_assert_int_eq(odhs_network_add(c.net, i, j, ODHS_CONTACT_TEMPORARY), ODHS_OK);
+        added++;
+    }
+    ck_assert_uint_eq(added, k);
+    free(gone);
+    ck_assert_int_eq(odhs_network_update_geometry(c.net, c.sys), ODHS_OK);
+    cm_rhs(c.net, &rng, b);
+    memset(x, 0, nmax * sizeof *x);
+    ck_assert(cm_vs_dense(p, c.net, b, x) < 1e-10);
+    double upd = cm_stat(p, "updates");
+    cm_note("bulk: nc %zu, %zu swapped: nnz_L %g -> %g, updates %g, factorizations %g", c.nc, k, nnz0,
+            cm_stat(p, "nnz_L"), upd, cm_stat(p, "factorizations"));
+    /* the k deletions went through, the insertions stopped part-way */
+    ck_assert_msg(upd >= (double)k && upd < 2.0 * (double)k, "%g updates for %zu + %zu changes", upd, k, k);
+    ck_assert_double_eq(cm_stat(p, "factorizations"), 2.0);
+    odhs_solver_destroy(p);
+    free(b);
+    free(x);
+    cm_case_free(&c);
+}
+END_TEST
+
 /* slot capacity: many contacts added one by one outgrow the factor */
 START_TEST(test_pcg_capacity)
 {
@@ -797,6 +869,13 @@ START_TEST(test_params_stats)
     ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", 0.0), ODHS_OK);
     ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", 1.0), ODHS_E_INVALID);
     ck_assert_int_eq(odhs_solver_set_param(p, "min_rcond", 1e-12), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_get_stat(p, "update_max", &v), ODHS_OK);
+    ck_assert_double_eq(v, 0.125);
+    ck_assert_int_eq(odhs_solver_set_param(p, "update_max", 1.5), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "update_max", -0.1), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_get_stat(p, "update_max", &v), ODHS_OK);
+    ck_assert_double_eq(v, 0.125); /* a rejected value leaves the old one */
+    ck_assert_int_eq(odhs_solver_set_param(s, "update_max", 0.5), ODHS_E_INVALID); /* pcg only */
     /* statistics before any solve */
     const char *keys[] = {"analyses", "factorizations", "updates", "rcond", "nnz_L", "flops", "iterations",
                           "cholmod_status"};
@@ -980,6 +1059,7 @@ Suite *make_cholmod_suite(void)
     tcase_add_test(tc, test_pcg_updates_moving_2d);
     tcase_add_test(tc, test_pcg_updates_moving_3d);
     tcase_add_test(tc, test_pcg_capacity);
+    tcase_add_test(tc, test_pcg_bulk_insertions);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("stepper");

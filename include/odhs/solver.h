@@ -80,10 +80,13 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
  *  module (cholmod_rowadd / cholmod_rowdel; GPL-2.0-or-later) when contacts
  *  appear or disappear, and refactored after "refactor_every" geometry
  *  changes (default 50), when CG needs more than "refactor_iterations"
- *  (default 40), when the slots run out or the fill doubles. Exact (one
- *  iteration) while the geometry is unchanged, e.g. during rewiring.
+ *  (default 40), when the slots run out or the fill doubles, and when more
+ *  than "update_max" (Nc + 64) contacts changed at once (default 0.125, in
+ *  [0, 1]; since 0.2.14; the batched integrator lowers it to 1/256 inside
+ *  its contact problems). Exact (one iteration) while the geometry is
+ *  unchanged, e.g. during rewiring.
  *  Parameters: "tol" (default 1e-12), "maxiter", "min_rcond",
- *  "refactor_every", "refactor_iterations". Statistics: "iterations",
+ *  "refactor_every", "refactor_iterations", "update_max". Statistics: "iterations",
  *  "updates", "factorizations", "analyses", "rcond", "nnz_L", "capacity". */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
 /** SuiteSparseQR on A = S^T (only in builds with SuiteSparse; otherwise

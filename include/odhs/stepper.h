@@ -99,10 +99,13 @@ enum {
      *  overlaps at a step end; pairs whose constraint is active end touching
      *  and join the network (collisions), contacts whose force would be
      *  negative leave it (openings). Events are reported at the end of their
-     *  step (time resolution h). First order in h: an error controller keeps
+     *  step (time resolution h): first the net changes of the step's contact
+     *  problem, then those of its end (a pair closed by the problem and
+     *  opened by the end's rewiring is a collision and an opening). First order in h: an error controller keeps
      *  h/2 times the root mean square (over particles) change of the
      *  non-affine velocities over a step below tol times the mean diameter
-     *  (default tol 1e-3, steps up to dt; odhs_stepper_set_tolerance).
+     *  (default tol 1e-3, steps up to dt, default 5e-2 with this integrator;
+     *  odhs_stepper_set_tolerance, odhs_stepper_set_dt).
      *  Drift correction after every step. A step whose contact problem is
      *  degenerate (a potentially jammed constrained set, a singular solve)
      *  is taken by the exact Heun scheme instead (odhs_stepper_batched_stats
@@ -110,8 +113,12 @@ enum {
     ODHS_INTEGRATOR_BATCHED = 2
 };
 
-/** Step size in units of tau (default 1e-3): the fixed step of
- *  ODHS_INTEGRATOR_EULER, the largest step of ODHS_INTEGRATOR_HEUN. */
+/** Step size in units of tau: the fixed step of ODHS_INTEGRATOR_EULER, the
+ *  largest step of ODHS_INTEGRATOR_HEUN and ODHS_INTEGRATOR_BATCHED. Default
+ *  1e-3, and 5e-2 for ODHS_INTEGRATOR_BATCHED (whose steps its tolerance
+ *  sets): odhs_stepper_set_integrator brings its integrator's default unless
+ *  dt was set here, which is then kept (as is the dt of a stepper read from
+ *  a checkpoint; since 0.2.14). */
 ODHS_API int odhs_stepper_set_dt(odhs_stepper *st, double dt);
 /** Choose the integrator (default ODHS_INTEGRATOR_HEUN, with tolerance 1e-6
  *  and drift correction after every step). The paper's scheme is the named mode
@@ -144,7 +151,9 @@ ODHS_API int odhs_stepper_set_event_callback(odhs_stepper *st, odhs_event_fn fn,
  * (Re)build the initial contact network from the system (pairs within the
  * contact tolerance), compute the valid network, forces and velocities. Called
  * automatically by the first step; call it again after changing the system,
- * driver or solver. Time and strain are kept.
+ * driver or solver. Time and strain are kept. With ODHS_INTEGRATOR_BATCHED
+ * the valid network is found in blocks of events, a few solves instead of
+ * one per opening (since 0.2.14; the same network).
  */
 ODHS_API int odhs_stepper_reset(odhs_stepper *st);
 

@@ -74,6 +74,7 @@ typedef struct {
     /* parameters */
     double dense_max, dense_fallback_max, lsq_dense_max, lsq_rcond, check_tol;
     double tol;           /* "tol" of the iterative backends (cg, cholmod-pcg); 0: their own */
+    double update_max;    /* "update_max" of cholmod-pcg */
     int prefer, retry_after, retry_after_lsq;
     /* state */
     int sticky_backend;   /* backend to try first, -1: none */
@@ -102,6 +103,7 @@ static int auto_create(void **state)
     s->prefer = 0;
     s->retry_after = 20;
     s->retry_after_lsq = 0;
+    s->update_max = 0.125;
     s->sticky_backend = -1;
     s->last = s->primary = -1;
     *state = s;
@@ -140,6 +142,9 @@ static int auto_set_param(void *state, const char *key, double v)
         s->tol = v;
         for (int k = 0; k < NHANDLES; ++k)
             if (s->h[k] && (k == B_CG || k == B_CHOLMOD_PCG)) odhs_solver_set_param(s->h[k], "tol", v);
+    } else if (!strcmp(key, "update_max") && v >= 0.0 && v <= 1.0) {
+        s->update_max = v;
+        if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "update_max", v);
     } else if (!strcmp(key, "prefer") && (v == 0.0 || v == 1.0)) s->prefer = (int)v;
     else if (!strcmp(key, "retry_after") && v >= 0.0 && v <= 1e9) {
         s->retry_after = (int)v;
@@ -183,6 +188,7 @@ static int handle(auto_state *s, int b, odhs_solver **out)
         if (st) return st;
         odhs_solver_set_check_tolerance(s->h[b], s->check_tol);
         if (s->tol > 0.0 && (b == B_CG || b == B_CHOLMOD_PCG)) odhs_solver_set_param(s->h[b], "tol", s->tol);
+        if (b == B_CHOLMOD_PCG && s->update_max != 0.125) odhs_solver_set_param(s->h[b], "update_max", s->update_max);
     }
     *out = s->h[b];
     return ODHS_OK;
@@ -390,6 +396,7 @@ static int auto_get_stat(void *state, const char *key, double *v)
     else if (!strcmp(key, "last_failure")) *v = s->last_failure;
     else if (!strcmp(key, "suitesparse")) *v = s->have_ss;
     else if (!strcmp(key, "tol")) *v = s->tol > 0.0 ? s->tol : 1e-12; /* the iterative backends' default */
+    else if (!strcmp(key, "update_max")) *v = s->update_max;
     else if (is_lsq(s->last)) {
         if (!strcmp(key, "rank")) *v = s->last_rank;
         else if (s->last == B_LSQ_CG) return odhs_solver_get_stat(s->lsqcg, key, v);

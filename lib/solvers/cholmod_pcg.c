@@ -36,9 +36,12 @@
  *     geometry changes (setups at which some normal had moved since the
  *     previous setup; default 50; 0 = never for this reason), when the slot
  *     capacity would be exceeded, when many contacts changed at once (more
- *     than (Nc + 64)/8: cheaper than updates), when the updates have doubled
- *     the fill of L, when an update leaves a D entry not above
- *     min_rcond * max(D) (a mixed-geometry matrix need not stay positive
+ *     than "update_max" (Nc + 64), default 1/8: cheaper than updates; the
+ *     batched integrator lowers it while it changes many contacts per
+ *     solve), when the updates have doubled the fill of L (checked after
+ *     the updates; while they run, an allocation of L beyond 2.5 times the
+ *     fresh factor's stops them), when an update leaves a D entry not
+ *     above min_rcond * max(D) (a mixed-geometry matrix need not stay positive
  *     definite, and a new contact can make N singular), and inside solve when
  *     PCG with an aged factor needs more than "refactor_iterations" (default
  *     40) iterations or breaks down: the solve then goes on from its current
@@ -46,7 +49,8 @@
  *     ODHS_E_SINGULAR, as for "cholmod".
  *   Parameters: "tol" (relative residual, default 1e-12), "maxiter" (default
  *   0 = 10*Nc + 100), "min_rcond" (1e-14), "refactor_every" (50),
- *   "refactor_iterations" (40), "supernodal" (only 0 is accepted: the Modify
+ *   "refactor_iterations" (40), "update_max" (0.125, in [0, 1]; since
+ *   0.2.14), "supernodal" (only 0 is accepted: the Modify
  *   module needs a simplicial LDL' factor). Statistics: "iterations" (of the
  *   last solve), "updates" (rowadd + rowdel calls), "factorizations",
  *   "analyses", "rcond" (of the last full factorisation), "nnz_L" (current),
@@ -101,11 +105,16 @@ typedef struct {
     size_t since;             /* geometry changes since the last full factorisation */
     size_t updates_since_analysis;
     double nnz0;              /* nnz(L) right after the last full factorisation */
+    double nzmax0;            /* and its allocation (L->nzmax) */
     /* parameters */
-    double tol, maxiter, min_rcond, refactor_every, refactor_iterations;
+    double tol, maxiter, min_rcond, refactor_every, refactor_iterations, update_max;
     /* statistics */
     double iterations, updates, factorizations, analyses, rcond, status;
 } pcg_state;
+
+/* insertions stop (and setup refactors) once the factor's allocation
+ * exceeds this multiple of the fresh factor's */
+#define PCG_NZMAX_GROWTH 2.5
 
 static int pcg_create(void **state)
 {
@@ -118,6 +127,7 @@ static int pcg_create(void **state)
     s->min_rcond = 1e-14;
     s->refactor_every = 50;
     s->refactor_iterations = 40;
+    s->update_max = 0.125;
     *state = s;
     return ODHS_OK;
 }
@@ -158,6 +168,7 @@ static int pcg_set_param(void *state, const char *key, double v)
     else if (!strcmp(key, "min_rcond") && v >= 0.0 && v < 1.0) s->min_rcond = v;
     else if (!strcmp(key, "refactor_every") && v >= 0.0) s->refactor_every = floor(v);
     else if (!strcmp(key, "refactor_iterations") && v >= 1.0) s->refactor_iterations = floor(v);
+    else if (!strcmp(key, "update_max") && v >= 0.0 && v <= 1.0) s->update_max = v;
     else if (!strcmp(key, "supernodal") && v == 0.0) { /* simplicial only */
     } else return ODHS_E_INVALID;
     return ODHS_OK;
@@ -176,6 +187,7 @@ static int pcg_get_stat(void *state, const char *key, double *v)
     else if (!strcmp(key, "capacity")) *v = (double)s->cap;
     else if (!strcmp(key, "cholmod_status")) *v = s->status;
     else if (!strcmp(key, "tol")) *v = s->tol;
+    else if (!strcmp(key, "update_max")) *v = s->update_max;
     else return ODHS_E_INVALID;
     return ODHS_OK;
 }
@@ -266,6 +278,7 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
     if ((st = odhs__cm_check_factor(s->L, &s->c, s->min_rcond, &s->rcond))) return st;
     if (s->L->is_super || s->L->is_ll) return ODHS_E_INTERNAL; /* Modify needs LDL' */
     s->nnz0 = odhs__cm_factor_nnz(s->L, &s->c);
+    s->nzmax0 = (double)s->L->nzmax;
     s->valid = 1;
     s->fresh = 1;
     return ODHS_OK;
@@ -433,6 +446,14 @@ static int pcg_insert(pcg_state *s, const odhs_network *net, int *refactor)
     }
     for (size_t c = 0; c < net->nc; ++c) {
         if (s->c2s[c] != NO_SLOT) continue;
+        /* a free slot sits where the last analysis put it, blind to the
+         * contact it will hold: many insertions can fill L far beyond the
+         * fresh factor. Its allocation (nzmax, O(1) to read) bounds them
+         * while they run; setup checks the fill itself afterwards */
+        if ((double)s->L->nzmax > PCG_NZMAX_GROWTH * s->nzmax0 + 4096.0) {
+            *refactor = 1;
+            return ODHS_OK;
+        }
         size_t t = s->freel[--s->nfree];
         if (pcg_rowadd(s, net, c, t)) {
             *refactor = 1;
@@ -465,7 +486,7 @@ static int pcg_setup(void *state, const odhs_network *net)
     }
     size_t nadd = 0;
     for (size_t c = 0; c < nc; ++c) nadd += s->c2s[c] == NO_SLOT;
-    if (nadd > s->nfree + ndel || 8 * (nadd + ndel) > nc + 64) return pcg_full(s, net);
+    if (nadd > s->nfree + ndel || (double)(nadd + ndel) > s->update_max * (double)(nc + 64)) return pcg_full(s, net);
     if (pcg_delete(s, ndel)) return pcg_full(s, net);
     if (nadd) {
         int refactor = 0;

@@ -442,6 +442,18 @@ int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const do
     return st;
 }
 
+int odhs__solver_push_param(odhs_solver *s, const char *key, double v, double *old)
+{
+    const odhs_solver_type *t = s->type;
+    if (!t->set_param || !t->get_stat || t->get_stat(s->state, key, old) != ODHS_OK) return 0;
+    return t->set_param(s->state, key, v) == ODHS_OK;
+}
+
+void odhs__solver_pop_param(odhs_solver *s, const char *key, int pushed, double old)
+{
+    if (pushed) s->type->set_param(s->state, key, old);
+}
+
 int odhs_solver_solve_ls(odhs_solver *s, const odhs_network *net, const double *g, double *x)
 {
     if (s && !g) return solerr(s, ODHS_E_NULL, "vector pointer is NULL");

@@ -43,5 +43,9 @@ int odhs__solver_solve(odhs_solver *s, const odhs_network *net, const double *b,
 int odhs__solver_solve_relaxed(odhs_solver *s, const odhs_network *net, const double *b, double *x, double rtol,
                                int reuse);
 void odhs__solver_invalidate(odhs_solver *s);
+/* set a backend parameter for a while (where the backend has it, quietly):
+ * 1 when set, with its value before in *old, for odhs__solver_pop_param */
+int odhs__solver_push_param(odhs_solver *s, const char *key, double v, double *old);
+void odhs__solver_pop_param(odhs_solver *s, const char *key, int pushed, double old);
 
 #endif /* ODHS_SOLVERS_SOLVERS_H */

@@ -13,7 +13,7 @@
  * -gap/h for 0 (forces.c: st->bh), solved by a block active-set method:
  * every negative force opens and every violated pair closes at once (a
  * primal-dual active set), then one removal at a time if that does not
- * settle. A network the problem cannot take (one that is potentially
+ * settle (for a few iterations). A network the problem cannot take (one that is potentially
  * jammed, a singular solve, no convergence) makes the step an exact,
  * event-driven one of the Heun scheme.
  *
@@ -35,6 +35,8 @@
 #define BATCHED_HMIN 1e-12
 /* block (primal-dual) iterations before one removal at a time */
 #define BLOCK_ITERS 8
+/* single removals after them before the step is left to the exact scheme */
+#define SINGLE_ITERS 24
 /* a pair counts as violated when its linearised end gap is below this
  * fraction of its contact distance */
 #define GAP_TOL 1e-13
@@ -65,6 +67,7 @@ static int back_to_start(odhs_stepper *st)
     int s = odhs__st_restart(st);
     memcpy(st->U, st->U0, st->nd * sizeof *st->U);
     st->nchg = 0;
+    st->chg_mark = 0;
     st->nrem = 0;
     return s;
 }
@@ -168,10 +171,14 @@ static int contact_problem(odhs_stepper *st, double h, int *ok)
     odhs_network *net = st->net;
     const int pressure = st->drv->pressure_on;
     int s = ODHS_OK;
-    size_t maxit = 4 * (net->nc + 16) + 200;
+    /* a problem that settles neither in blocks nor in a few single
+     * removals is left to the exact scheme, which is then cheaper */
+    const size_t maxit = BLOCK_ITERS + SINGLE_ITERS;
     *ok = 0;
     st->bh = h;
     st->nrem = 0;
+    double old_um;
+    const int pushed = odhs__solver_push_param(st->sol, "update_max", ODHS__BATCH_UPDATE_MAX, &old_um);
     for (size_t it = 0; it < maxit; ++it) {
         long excess;
         if ((s = odhs__net_excess(net, &excess))) {
@@ -200,6 +207,7 @@ static int contact_problem(odhs_stepper *st, double h, int *ok)
         }
     }
     st->bh = 0.0;
+    odhs__solver_pop_param(st->sol, "update_max", pushed, old_um);
     return s;
 }
 
@@ -213,7 +221,14 @@ static int exact_step(odhs_stepper *st, odhs__step_plan *p, double h)
     p->exact = 1;
     st->h = fmax(0.5 * h / st->tau, batched_hmin(st));
     const double hb = st->h;
+    /* the factor holds the contact problem's last active set: the first
+     * setup of the exact step undoes many changes at once, which a fresh
+     * factorisation does more cheaply (and in far less memory at large N)
+     * than updates */
+    double old_um;
+    const int pushed = odhs__solver_push_param(st->sol, "update_max", ODHS__BATCH_UPDATE_MAX, &old_um);
     s = odhs__st_advance_exact(st, &odhs__step_heun, p);
+    odhs__solver_pop_param(st->sol, "update_max", pushed, old_um);
     st->h = hb;
     return s;
 }
@@ -254,6 +269,9 @@ static int batched_advance(odhs_stepper *st, odhs__step_plan *p)
         if ((s = back_to_start(st)) || (s = cover(st, h, INFINITY, &rebuilt))) return s;
         if (rate * h > 0.9 * st->skin) h = 0.9 * st->skin / rate;
     }
+    /* the problem's contact changes are the step's collisions and openings
+     * on their own; its end's (drift correction, rewiring) come after */
+    st->chg_mark = st->nchg;
     memcpy(p->G, st->G, sizeof p->G);
     memcpy(st->Ua, st->U, st->nd * sizeof *st->Ua);
     p->vel = st->Ua;
@@ -306,6 +324,8 @@ static int batched_judge(odhs_stepper *st, odhs__step_plan *p, int *again)
 }
 
 /* default drift-correction interval: every step (the active pairs end
- * touching to second order in h) */
+ * touching to second order in h); the first step 1/50 of dt (the
+ * controller doubles it from there: a first step of dt, rejected, would
+ * cost a contact problem with most near pairs in it) */
 const odhs__step_type odhs__step_batched = {ODHS_INTEGRATOR_BATCHED, "batched", 1u, batched_begin, NULL, NULL, NULL,
-                                            NULL,                    batched_advance, batched_judge, 1e-3};
+                                            NULL,                    batched_advance, batched_judge, 1e-3, 5e-2, 2e-2, 1};

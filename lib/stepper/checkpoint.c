@@ -141,7 +141,8 @@ int odhs__ckpt_read_stepper(odhs__ckpt_in *in)
     st->integrator = (int)integ;
     st->corr_every = (unsigned)corr;
     st->corr_user = 1; /* the file's interval is kept by set_integrator */
-    st->tol_user = 1;  /* and so is its tolerance */
+    st->tol_user = 1;  /* and so are its tolerance */
+    st->dt_user = 1;   /* and dt */
     st->jammed = (int)jam;
     st->nb_stale = (int)stale;
     if ((s = check_stepper(in, st))) return s;

@@ -16,4 +16,4 @@ static int euler_plan(odhs_stepper *st, odhs__step_plan *p)
 
 /* default drift-correction interval: the paper's 10 steps (its straight
  * chords only open contact gaps, by O(dt^2)) */
-const odhs__step_type odhs__step_euler = {ODHS_INTEGRATOR_EULER, "euler", 10u, NULL, euler_plan, NULL, NULL, NULL, NULL, NULL, 1e-6};
+const odhs__step_type odhs__step_euler = {ODHS_INTEGRATOR_EULER, "euler", 10u, NULL, euler_plan, NULL, NULL, NULL, NULL, NULL, 1e-6, 1e-3, 1.0, 0};

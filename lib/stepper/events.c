@@ -24,16 +24,15 @@ static int cmp_change(const void *a, const void *b)
     return 0;
 }
 
-/* turn the step's recorded changes into net events */
-static int collect_events(odhs_stepper *st)
+/* the net events of the changes [lo, hi), appended */
+static int collect_range(odhs_stepper *st, size_t lo, size_t hi)
 {
-    st->nev = 0;
-    if (st->nchg == 0) return ODHS_OK;
-    qsort(st->chg, st->nchg, sizeof *st->chg, cmp_change);
-    for (size_t a = 0; a < st->nchg;) {
+    if (hi <= lo) return ODHS_OK;
+    qsort(st->chg + lo, hi - lo, sizeof *st->chg, cmp_change);
+    for (size_t a = lo; a < hi;) {
         size_t b = a;
         int sum = 0;
-        while (b < st->nchg && st->chg[b].i == st->chg[a].i && st->chg[b].j == st->chg[a].j) sum += st->chg[b++].delta;
+        while (b < hi && st->chg[b].i == st->chg[a].i && st->chg[b].j == st->chg[a].j) sum += st->chg[b++].delta;
         if (sum != 0) {
             if (odhs__reserve((void **)&st->ev, &st->evcap, st->nev + 1, sizeof *st->ev))
                 return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");
@@ -46,8 +45,22 @@ static int collect_events(odhs_stepper *st)
         }
         a = b;
     }
-    st->nchg = 0;
     return ODHS_OK;
+}
+
+/* turn the step's recorded changes into net events: those before the mark
+ * (a batched step's contact problem) and those after it (its end) each net
+ * on their own, so that a pair that closes within a batched step and opens
+ * at its end is a collision and an opening, as in the exact scheme */
+static int collect_events(odhs_stepper *st)
+{
+    const size_t mark = st->chg_mark < st->nchg ? st->chg_mark : st->nchg;
+    st->nev = 0;
+    int s = collect_range(st, 0, mark);
+    if (!s) s = collect_range(st, mark, st->nchg);
+    st->nchg = 0;
+    st->chg_mark = 0;
+    return s;
 }
 
 int odhs__st_emit_events(odhs_stepper *st, odhs_event *first, int *stop)

@@ -290,4 +290,4 @@ static int heun_at_opening(odhs_stepper *st, odhs__step_plan *p, int *again)
  * errors (O(h^3), either sign) would otherwise leave overlaps of ~1e-11 at
  * tol 1e-6 (docs/accuracy.md) */
 const odhs__step_type odhs__step_heun = {ODHS_INTEGRATOR_HEUN, "heun", 1u, heun_begin, heun_plan, heun_early,
-                                         heun_at_collision,    heun_at_opening, NULL, NULL, 1e-6};
+                                         heun_at_collision,    heun_at_opening, NULL, NULL, 1e-6, 1e-3, 1.0, 0};

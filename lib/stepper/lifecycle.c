@@ -93,7 +93,8 @@ int odhs_stepper_set_dt(odhs_stepper *st, double dt)
     if (!isfinite(dt)) return odhs__sterr(st, ODHS_E_NONFINITE, "dt is not finite");
     if (!(dt > 0.0)) return odhs__sterr(st, ODHS_E_INVALID, "dt = %g must be > 0", dt);
     st->dt = dt;
-    st->h = dt;
+    st->h = dt * odhs__step_type_find(st->integrator)->h_first;
+    st->dt_user = 1;
     return ODHS_OK;
 }
 
@@ -104,7 +105,8 @@ int odhs_stepper_set_integrator(odhs_stepper *st, int integrator)
     const odhs__step_type *type = odhs__step_type_find(integrator);
     if (!type) return odhs__sterr(st, ODHS_E_INVALID, "unknown integrator %d", integrator);
     st->integrator = integrator;
-    st->h = st->dt;
+    if (!st->dt_user) st->dt = type->dt_default;
+    st->h = st->dt * type->h_first;
     if (!st->corr_user) st->corr_every = type->corr_default;
     if (!st->tol_user) st->tol = type->tol_default;
     return ODHS_OK;
@@ -279,8 +281,14 @@ int odhs_stepper_reset(odhs_stepper *st)
     odhs__prop_start(st->drv, st->time, st->lambda);
     if ((s = odhs__st_external_forces(st))) goto fail;
     st->nchg = 0;
-    if ((s = odhs__st_rewire(st))) goto fail;
+    st->chg_mark = 0;
+    /* a step type that rewires in blocks does so from the detected network
+     * too: at large N a start (a tiled packing, a file) can hold thousands
+     * of tensile contacts, and one solve per event grows like N^2 */
+    if ((s = odhs__step_type_find(st->integrator)->block_rewire ? odhs__st_rewire_block(st) : odhs__st_rewire(st)))
+        goto fail;
     st->nchg = 0;
+    st->chg_mark = 0;
     st->drv_version = st->drv->version;
     st->sys_version = st->sys->version;
     st->ready = 1;
@@ -289,5 +297,6 @@ fail:
     if (psaved) odhs__prop_restore(st->drv);
     if (s < 0) odhs__st_rollback(st);
     st->nchg = 0;
+    st->chg_mark = 0;
     return s;
 }

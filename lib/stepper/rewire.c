@@ -250,3 +250,84 @@ int odhs__st_rewire(odhs_stepper *st)
         if ((s = close_pair(st, &added)) || !added) return s;
     }
 }
+
+/* Block rewiring, for a step that ends with many events at once (the
+ * batched integrator, whose openings all surface at the step's end): every
+ * contact with a negative force opens and every removed pair that
+ * approaches is re-connected at once, from one solve (a primal-dual active
+ * set), a few times over. It stops on the tests of the paper's rule, so it
+ * reaches the same (unique) valid network, with a few solves instead of one
+ * per event. A network beyond isostatic, or no settling within the few
+ * iterations (more while the number of changes keeps falling: from a
+ * detected network at large N, e.g. a reset, the first block opens half
+ * the contacts and the changes then shrink geometrically), puts every
+ * removed pair back and leaves the rest to the rewiring above. */
+#define BLOCK_REWIRE_ITERS 8
+#define BLOCK_REWIRE_ITERS_MAX 64
+static int rewire_block(odhs_stepper *st)
+{
+    odhs_network *net = st->net;
+    int s, settled = 0;
+    size_t prev = SIZE_MAX;
+    st->nrem = 0;
+    for (int it = 0; it < BLOCK_REWIRE_ITERS_MAX && !settled; ++it) {
+        long excess;
+        if ((s = odhs__net_excess(net, &excess))) return odhs__sterr(st, s, "%s", net->errmsg);
+        if (excess > (st->drv->pressure_on ? 1 : 0)) break;
+        int pj = 0;
+        if ((s = rewire_forces(st, &pj))) {
+            if (s == ODHS_E_NOMEM) return s;
+            break; /* the rewiring above reports it */
+        }
+        if (pj) break;
+        double fmax = 0.0;
+        for (size_t c = 0; c < net->nc; ++c) fmax = fmax > fabs(net->f[c]) ? fmax : fabs(net->f[c]);
+        odhs__st_compute_velocities(st);
+        /* the removed pairs that approach under these velocities ... */
+        const double vs = odhs__st_velocity_scale(st);
+        size_t nback = 0;
+        for (size_t q = 0; q < st->nrem; ++q)
+            if (odhs__st_pair_velocity(st, st->rem[q].i, st->rem[q].j) < -EPS_V * vs) {
+                odhs_change t = st->rem[q];
+                st->rem[q] = st->rem[nback];
+                st->rem[nback++] = t;
+            }
+        /* ... open the negative contacts (into the removed pairs, after
+         * those) ... */
+        size_t opened = 0;
+        for (size_t c = net->nc; c-- > 0;)
+            if (odhs__can_open(net->kind[c]) && net->f[c] < -EPS_F * fmax) {
+                if ((s = odhs__st_open_contact(st, c, NULL))) return s;
+                opened++;
+            }
+        /* ... and re-connect the approaching ones */
+        for (size_t q = 0; q < nback; ++q) {
+            size_t c;
+            if ((s = odhs__st_add_contact(st, st->rem[q].i, st->rem[q].j, &c))) return s;
+            odhs__st_contact_geometry(st, c);
+        }
+        memmove(st->rem, st->rem + nback, (st->nrem - nback) * sizeof *st->rem);
+        st->nrem -= nback;
+        settled = !opened && !nback;
+        if (!settled && it + 1 >= BLOCK_REWIRE_ITERS && opened + nback >= prev) break;
+        prev = opened + nback;
+    }
+    if (settled) return ODHS_OK;
+    /* the network of this rewiring's start back, then the paper's rule */
+    for (size_t q = 0; q < st->nrem; ++q) {
+        size_t c;
+        if ((s = odhs__st_add_contact(st, st->rem[q].i, st->rem[q].j, &c))) return s;
+        odhs__st_contact_geometry(st, c);
+    }
+    st->nrem = 0;
+    return odhs__st_rewire(st);
+}
+
+int odhs__st_rewire_block(odhs_stepper *st)
+{
+    double old;
+    const int pushed = odhs__solver_push_param(st->sol, "update_max", ODHS__BATCH_UPDATE_MAX, &old);
+    int s = rewire_block(st);
+    odhs__solver_pop_param(st->sol, "update_max", pushed, old);
+    return s;
+}

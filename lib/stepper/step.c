@@ -35,6 +35,7 @@ static int undo(odhs_stepper *st, const step_undo *u, int s)
     st->nrejected = u->nrejected;
     st->jammed = 0;
     st->nchg = 0;
+    st->chg_mark = 0;
     return s;
 }
 
@@ -146,8 +147,9 @@ int odhs__st_advance_exact(odhs_stepper *st, const odhs__step_type *type, odhs__
  * drift correction (before the rewiring: its solve is then that of the
  * corrected geometry, and contacts the correction adds are rewired with the
  * step's events), rewiring; the events follow (do_step) */
-static int end_step(odhs_stepper *st, const odhs__step_plan *p, step_undo *u)
+static int end_step(odhs_stepper *st, const odhs__step_type *type, const odhs__step_plan *p, step_undo *u)
 {
+    int (*rewire)(odhs_stepper *) = type->block_rewire && !p->exact ? odhs__st_rewire_block : odhs__st_rewire;
     int s;
     if (p->at_switch) {
         if (!u->psaved) odhs__prop_save(st->drv);
@@ -160,7 +162,7 @@ static int end_step(odhs_stepper *st, const odhs__step_plan *p, step_undo *u)
         int added = 0;
         if ((s = odhs__st_correct(st, &added))) return s;
     }
-    if ((s = odhs__st_rewire(st))) return s;
+    if ((s = rewire(st))) return s;
     if (st->corr_skipped && st->drv->pressure_on && !st->jammed) {
         /* a collision made the network over-constrained (excess 2), so the
          * correction waited for the rewiring to open a contact: correct
@@ -190,6 +192,7 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     if ((s = odhs__st_save(st))) return s;
     step_undo u = {st->drv_version, st->nrejected, st->tau, st->h, 0};
     st->nchg = 0;
+    st->chg_mark = 0;
     if ((s = driver_update(st, &u, first, stop, &done))) return undo(st, &u, s);
     if (done) {
         st->last_driver_only = 1;
@@ -212,7 +215,7 @@ static int do_step(odhs_stepper *st, double limit, odhs_event *first, int *stop)
     for (;;) {
         int again = 0;
         s = type->advance ? type->advance(st, &p) : odhs__st_advance_exact(st, type, &p);
-        if (s || (s = end_step(st, &p, &u)) || (type->judge && (s = type->judge(st, &p, &again))))
+        if (s || (s = end_step(st, type, &p, &u)) || (type->judge && (s = type->judge(st, &p, &again))))
             return undo(st, &u, s);
         if (!again) break;
         /* the scheme took the step back: anew, to the same limit */
@@ -244,6 +247,7 @@ int odhs_stepper_correct(odhs_stepper *st)
     if ((s = odhs__st_save(st))) return s;
     const int jammed0 = st->jammed;
     st->nchg = 0;
+    st->chg_mark = 0;
     if ((s = odhs__st_correct(st, &added))) goto fail;
     if ((s = odhs__st_rewire(st)) || (s = check_flow(st))) goto fail;
     if ((s = odhs__st_emit_events(st, NULL, &stop))) goto fail;
@@ -253,6 +257,7 @@ fail:
     odhs__st_rollback(st);
     st->jammed = jammed0;
     st->nchg = 0;
+    st->chg_mark = 0;
     return s;
 }
 

@@ -38,6 +38,7 @@ struct odhs_stepper {
     int integrator;   /* ODHS_INTEGRATOR_* */
     double tol;       /* adaptive: error per step, relative to the mean diameter */
     int tol_user;     /* the tolerance was set (not the integrator's default) */
+    int dt_user;      /* dt was set (not the integrator's default) */
     double bh;        /* > 0 while the batched step's contact problem is solved:
                        * the step, over which each contact's gap closes (forces.c) */
     uint64_t nbatched, nbatched_exact, nbatched_solves; /* batched.c (not checkpointed) */
@@ -107,6 +108,7 @@ struct odhs_stepper {
     int pj_bordered;
     odhs_change *chg;
     size_t nchg, chgcap;
+    size_t chg_mark;  /* changes before it net on their own (events.c) */
     /* rollback snapshot: xs holds 3 nd doubles, positions then Us, Fs */
     double *xs, *Us, *Fs; /* Us, Fs: velocities and external forces */
     int has_Fs;
@@ -153,6 +155,14 @@ void odhs__st_stress_of(const odhs_stepper *st, const double *f, double *sigma);
  * (before the step's events) into the pending record (forces.c) */
 int odhs__st_pre_event_record(odhs_stepper *st);
 #define EPS_F 1e-12 /* relative threshold for negative forces   */
+/* while many contacts change per solve (a batched step's contact problem,
+ * the block rewiring), cholmod-pcg refactorises instead of updating its
+ * factor contact by contact once more than this fraction of the contacts
+ * changed since its last solve (its own default 1/8 suits one event per
+ * solve; the updates also grow the factor's storage) */
+#ifndef ODHS__BATCH_UPDATE_MAX
+#define ODHS__BATCH_UPDATE_MAX (1.0 / 256.0)
+#endif
 #define EPS_V 1e-12 /* relative threshold for approaching pairs */
 
 /* record an error message on the stepper (logically mutable) */
@@ -219,6 +229,9 @@ typedef struct {
      * start of the step, to take it anew (an error controller) */
     int (*judge)(odhs_stepper *st, odhs__step_plan *p, int *again);
     double tol_default; /* the tolerance this integrator starts with */
+    double dt_default;  /* and its dt (odhs_stepper_set_dt) */
+    double h_first;     /* its first adaptive step, relative to dt */
+    int block_rewire;   /* the step's end rewires by block updates (odhs__st_rewire_block) */
 } odhs__step_type;
 
 extern const odhs__step_type odhs__step_euler; /* euler.c: the paper's scheme */
@@ -273,6 +286,8 @@ int odhs__st_correct_isostatic(odhs_stepper *st, double *Z);
 
 /* ---- rewire.c, endgame.c ---------------------------------------------------- */
 int odhs__st_rewire(odhs_stepper *st);
+/* the same network by block updates (many events at once; rewire.c) */
+int odhs__st_rewire_block(odhs_stepper *st);
 int odhs__st_open_contact(odhs_stepper *st, size_t k, double *x);
 int odhs__st_jam_finish(odhs_stepper *st);
 
