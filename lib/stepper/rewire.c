@@ -306,7 +306,7 @@ static int rewire_block(odhs_stepper *st)
             if ((s = odhs__st_add_contact(st, st->rem[q].i, st->rem[q].j, &c))) return s;
             odhs__st_contact_geometry(st, c);
         }
-        memmove(st->rem, st->rem + nback, (st->nrem - nback) * sizeof *st->rem);
+        if (nback) memmove(st->rem, st->rem + nback, (st->nrem - nback) * sizeof *st->rem); /* rem may be NULL */
         st->nrem -= nback;
         settled = !opened && !nback;
         if (!settled && it + 1 >= BLOCK_REWIRE_ITERS && opened + nback >= prev) break;
