@@ -21,6 +21,8 @@
  *
  * usage: batched [DIM] [NLIST] [SVG] [EXACT_NMAX] [EVENTS] [NBUILD]
  *        defaults 2  1024,4096,16384,65536  batched_2d.svg  16384  1000  16384
+ *        batched --plot TABLE SVG: fits and plot of a table printed by an
+ *          earlier run (one cut short included)
  *        batched --memory DIM N [NBUILD [STEPS]]: STEPS (default 5) batched
  *          steps at N (tiled from N / 2^DIM ... down to NBUILD), peak RSS
  *        batched --accuracy DIM N SEEDS STRAIN: steady-state sxy, p, z and
@@ -498,10 +500,98 @@ static int accuracy(int dim, size_t n, int seeds, double w)
     return 0;
 }
 
+/* the cost per unit strain of each setting against N: fitted exponents
+ * (printed) and the SVG plot */
+static void plot_costs(int dim, const size_t *ns, size_t nn, double cost[][16], int ok[][16], const char *note,
+                       const char *svg)
+{
+    pl_plot p;
+    char title[96];
+    snprintf(title, sizeof title, "Cost per unit strain, %dD, phi = %.2f", dim, dim == 2 ? 0.80 : 0.60);
+    pl_init(&p, title, "N", "CPU seconds per unit strain", 1, 1);
+    for (int s = 0; s < S_COUNT; ++s) {
+        double x[16], y[16];
+        size_t m = 0;
+        for (size_t q = 0; q < nn; ++q)
+            if (ok[s][q]) {
+                x[m] = (double)ns[q];
+                y[m++] = cost[s][q];
+            }
+        if (!m) continue;
+        int k = pl_series_add(&p, sname[s], s, 0, s + 1);
+        for (size_t i = 0; i < m; ++i) pl_point(&p, k, x[i], y[i]);
+        if (m >= 2) {
+            double a = 0.0, e = pl_fit_loglog(x, y, m, &a);
+            printf("# %s: cost per unit strain ~ N^%.2f (least-squares fit, %zu sizes, N = %zu..%zu)\n", sname[s], e,
+                   m, (size_t)x[0], (size_t)x[m - 1]);
+            char lab[64];
+            snprintf(lab, sizeof lab, "fit N^%.2f", e);
+            int f = pl_series_add(&p, lab, s, 1, 0);
+            pl_point(&p, f, x[0], exp(a) * pow(x[0], e));
+            pl_point(&p, f, x[m - 1], exp(a) * pow(x[m - 1], e));
+        }
+    }
+    pl_note(&p, note);
+    if (pl_write_svg(&p, svg)) fprintf(stderr, "batched: cannot write %s\n", svg);
+    else printf("# plot: %s\n", svg);
+    pl_free(&p);
+}
+
+/* --plot TABLE SVG: the fits and the plot of a table this program printed
+ * (rows of a run cut short included) */
+static int plot_table(const char *table, const char *svg)
+{
+    FILE *f = fopen(table, "r");
+    if (!f) {
+        fprintf(stderr, "batched: cannot read %s\n", table);
+        return 1;
+    }
+    char line[512], note[300] = "", head[200] = "";
+    size_t ns[16], nn = 0;
+    double cost[S_COUNT][16];
+    int ok[S_COUNT][16], dim = 2;
+    memset(ok, 0, sizeof ok);
+    while (fgets(line, sizeof line, f)) {
+        if (line[0] == '#') {
+            if (strstr(line, "3D bidisperse")) dim = 3;
+            if (!strncmp(line, "# machine: ", 11)) snprintf(head, sizeof head, "%.*s", (int)strcspn(line + 11, ";\n"), line + 11);
+            continue;
+        }
+        size_t n, nc;
+        double phi;
+        if (sscanf(line, "%zu %zu %lf", &n, &nc, &phi) != 3) continue;
+        for (int s = 0; s < S_COUNT; ++s) {
+            const char *t = strstr(line, sname[s]);
+            double strain, cpu_s, per;
+            unsigned long long steps, nex, ev;
+            if (!t || sscanf(t + strlen(sname[s]), "%lf %llu %llu %llu %lf %lf", &strain, &steps, &nex, &ev, &cpu_s,
+                              &per) != 6)
+                continue;
+            size_t q = 0;
+            while (q < nn && ns[q] != n) ++q;
+            if (q == nn) {
+                if (nn == 16) break;
+                ns[nn++] = n;
+            }
+            cost[s][q] = per;
+            ok[s][q] = 1;
+        }
+    }
+    fclose(f);
+    if (!nn) {
+        fprintf(stderr, "batched: no rows in %s\n", table);
+        return 1;
+    }
+    snprintf(note, sizeof note, "%.160s; from %.100s", head, table);
+    plot_costs(dim, ns, nn, cost, ok, note, svg);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 5 && !strcmp(argv[1], "--accuracy"))
         return accuracy(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]));
+    if (argc > 3 && !strcmp(argv[1], "--plot")) return plot_table(argv[2], argv[3]);
     if (argc > 3 && !strcmp(argv[1], "--memory"))
         return memory(atoi(argv[2]), (size_t)atol(argv[3]), argc > 4 ? (size_t)atol(argv[4]) : 16384,
                       argc > 5 ? atoi(argv[5]) : 5);
@@ -575,38 +665,9 @@ int main(int argc, char **argv)
         printf("# N = %zu: start %.0f s wall%s\n", ns[q], b.build_s, ns[q] > nbuild ? " (tiled)" : "");
     }
     remove(path);
-    pl_plot p;
-    char title[96];
-    snprintf(title, sizeof title, "Cost per unit strain, %dD, phi = %.2f", dim, dim == 2 ? 0.80 : 0.60);
-    pl_init(&p, title, "N", "CPU seconds per unit strain", 1, 1);
-    for (int s = 0; s < S_COUNT; ++s) {
-        double x[16], y[16];
-        size_t m = 0;
-        for (size_t q = 0; q < nn; ++q)
-            if (ok[s][q]) {
-                x[m] = (double)ns[q];
-                y[m++] = cost[s][q];
-            }
-        if (!m) continue;
-        int k = pl_series_add(&p, sname[s], s, 0, s + 1);
-        for (size_t i = 0; i < m; ++i) pl_point(&p, k, x[i], y[i]);
-        if (m >= 2) {
-            double a = 0.0, e = pl_fit_loglog(x, y, m, &a);
-            printf("# %s: cost per unit strain ~ N^%.2f (least-squares fit, %zu sizes, N = %zu..%zu)\n", sname[s], e,
-                   m, (size_t)x[0], (size_t)x[m - 1]);
-            char lab[64];
-            snprintf(lab, sizeof lab, "fit N^%.2f", e);
-            int f = pl_series_add(&p, lab, s, 1, 0);
-            pl_point(&p, f, x[0], exp(a) * pow(x[0], e));
-            pl_point(&p, f, x[m - 1], exp(a) * pow(x[m - 1], e));
-        }
-    }
     char note[300];
     snprintf(note, sizeof note, "%.120s, %ld CPUs (load %.1f); exact over %g events, batched over strain 0.3", cpu,
              sysconf(_SC_NPROCESSORS_ONLN), la[0], events);
-    pl_note(&p, note);
-    if (pl_write_svg(&p, svg)) fprintf(stderr, "batched: cannot write %s\n", svg);
-    else printf("# plot: %s\n", svg);
-    pl_free(&p);
+    plot_costs(dim, ns, nn, cost, ok, note, svg);
     return 0;
 }
