@@ -29,6 +29,11 @@
  *          collisions per unit strain of exact and batched runs (block
  *          means, SEEDS starts, over STRAIN each), and the convergence of
  *          a trajectory over strain 0.01 as the tolerance and the step fall
+ *        batched --rd0 DIM N SEEDS STRAIN [RATES]: the same starts sheared
+ *          by the hard-sphere settings and by the library's RD0 at each
+ *          rate (default 1e-3,3e-4,1e-4,3e-5,1e-5): stress per unit rate
+ *          against the exact scheme's, cost per unit strain against the
+ *          batched default's (issue 18's RD0 comparison)
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -302,6 +307,28 @@ typedef struct {
     uint64_t steps;
 } stats;
 
+/* mean and standard error of nb block means per quantity */
+static void block_stats(double blk[][4], int nb, stats *out)
+{
+    for (int a = 0; a < 4; ++a) {
+        double m = 0, v = 0;
+        for (int b = 0; b < nb; ++b) m += blk[b][a] / nb;
+        for (int b = 0; b < nb; ++b) v += (blk[b][a] - m) * (blk[b][a] - m);
+        out->mean[a] = m;
+        out->err[a] = sqrt(v / ((double)nb * (nb - 1)));
+    }
+}
+
+/* pooled mean and standard error of got values */
+static void pooled(const double *v, int got, double *m, double *e)
+{
+    *m = 0.0;
+    *e = 0.0;
+    for (int i = 0; i < got; ++i) *m += v[i] / got;
+    for (int i = 0; i < got; ++i) *e += (v[i] - *m) * (v[i] - *m);
+    *e = got > 1 ? sqrt(*e / ((double)got * (got - 1))) : NAN;
+}
+
 /* shear sys over strain w, sampling sxy, p, z every 0.01 and collisions per
  * block; block means (nb blocks) -> mean and standard error */
 static int sample_run(odhs_system *sys, int setting, double w, int nb, stats *out)
@@ -334,13 +361,7 @@ static int sample_run(odhs_system *sys, int setting, double w, int nb, stats *ou
     }
     out->cpu = bench_cpu() - c0;
     odhs_stepper_counts(st, &out->steps, NULL, NULL);
-    for (int a = 0; a < 4; ++a) {
-        double m = 0, v = 0;
-        for (int b = 0; b < nb; ++b) m += blk[b][a] / nb;
-        for (int b = 0; b < nb; ++b) v += (blk[b][a] - m) * (blk[b][a] - m);
-        out->mean[a] = m;
-        out->err[a] = sqrt(v / ((double)nb * (nb - 1)));
-    }
+    block_stats(blk, nb, out);
     if (rc) fprintf(stderr, "batched: %s failed: %s\n", sname[setting], odhs_stepper_errmsg(st));
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
@@ -397,6 +418,25 @@ static int trajectory(const odhs_system *start, int integ, double tol, double dt
     return rc;
 }
 
+/* seed k's start: batched compression, warm-up to strain 1 (batched) */
+static int warmed_seed(int dim, size_t n, int k, odhs_system **out)
+{
+    odhs_system *sys;
+    if (compress_seed(dim, n, dim == 2 ? 0.80 : 0.60, 101 + 7 * (unsigned)k, &sys)) return 1;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
+    int rc = odhs_stepper_reset(st);
+    if (!rc) rc = odhs_stepper_run_until_strain(st, 1.0);
+    if (!rc) rc = odhs_stepper_correct(st);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    if (rc) odhs_system_destroy(sys);
+    else *out = sys;
+    return rc != 0;
+}
+
 static int accuracy(int dim, size_t n, int seeds, double w)
 {
     double phi = dim == 2 ? 0.80 : 0.60;
@@ -413,17 +453,7 @@ static int accuracy(int dim, size_t n, int seeds, double w)
     odhs_system *first = NULL;
     for (int k = 0; k < seeds; ++k) {
         odhs_system *sys;
-        if (compress_seed(dim, n, phi, 101 + 7 * k, &sys)) return 1;
-        odhs_solver *sol;
-        odhs_driver *drv;
-        odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
-        int rc = odhs_stepper_reset(st);
-        if (!rc) rc = odhs_stepper_run_until_strain(st, 1.0);
-        if (!rc) rc = odhs_stepper_correct(st);
-        odhs_stepper_destroy(st);
-        odhs_driver_destroy(drv);
-        odhs_solver_destroy(sol);
-        if (rc) return 1;
+        if (warmed_seed(dim, n, k, &sys)) return 1;
         if (k == 0) odhs_system_clone(sys, &first);
         for (int s = 0; s < S_COUNT; ++s) {
             odhs_system *c;
@@ -449,10 +479,7 @@ static int accuracy(int dim, size_t n, int seeds, double w)
         for (int a = 0; a < 4; ++a) {
             double m[S_COUNT] = {0}, e[S_COUNT] = {0};
             for (int q = 0; q < S_COUNT; ++q) {
-                if (got[q] < 2) continue;
-                for (int i = 0; i < got[q]; ++i) m[q] += pool[q][a][i] / got[q];
-                for (int i = 0; i < got[q]; ++i) e[q] += (pool[q][a][i] - m[q]) * (pool[q][a][i] - m[q]);
-                e[q] = sqrt(e[q] / ((double)got[q] * (got[q] - 1)));
+                if (got[q] >= 2) pooled(pool[q][a], got[q], &m[q], &e[q]);
             }
             double z = s == S_EXACT ? 0.0 : (m[s] - m[S_EXACT]) / sqrt(e[s] * e[s] + e[S_EXACT] * e[S_EXACT]);
             printf("  %s %.4g+-%.2g (%+.1f sigma)", a == 0 ? "sxy" : a == 1 ? "p" : a == 2 ? "z" : "coll/strain", m[s],
@@ -497,6 +524,138 @@ static int accuracy(int dim, size_t n, int seeds, double w)
     free(x0);
     free(x);
     odhs_system_destroy(first);
+    return 0;
+}
+
+/* ---- --rd0: the soft-core route at equal stress ------------------------------ */
+#define RD0_WARM 0.1 /* strain of RD0's own transient from the hard-sphere state */
+
+/* RD0 with the library's defaults (k_e = 1, k_d = 1 = 1/xi0, explicit Euler
+ * at 0.1 tau_e) at shear rate `rate` from sys (moved in place): warm-up
+ * RD0_WARM, then sxy / rate, p / rate and z (overlapping neighbours) sampled
+ * every 0.01 of strain over w in nb blocks; CPU and steps of the window */
+static int rd0_sample(odhs_system *sys, double rate, double w, int nb, stats *out)
+{
+    odhs_softcore *sc;
+    memset(out, 0, sizeof *out);
+    int rc = odhs_softcore_create(sys, &sc);
+    if (rc) return rc;
+    rc = odhs_softcore_set_model(sc, ODHS_SOFTCORE_RD0);
+    if (!rc) rc = odhs_softcore_set_shear_rate(sc, rate);
+    if (!rc) rc = odhs_softcore_run_until_strain(sc, RD0_WARM);
+    double blk[64][4], c0 = bench_cpu();
+    int ns = (int)lround(w / 0.01), per = ns / nb;
+    uint64_t s0 = 0;
+    odhs_softcore_counts(sc, &s0, NULL, NULL);
+    for (int b = 0; b < nb && !rc; ++b) {
+        double acc[3] = {0, 0, 0};
+        for (int k = 0; k < per && !rc; ++k) {
+            double sig[9], p = 0, z = 0;
+            rc = odhs_softcore_run_until_strain(sc, RD0_WARM + 0.01 * (b * per + k + 1));
+            if (!rc) rc = odhs_softcore_stress(sc, ODHS_SOFTCORE_STRESS_TOTAL, sig);
+            if (!rc) rc = odhs_softcore_pressure(sc, &p);
+            if (!rc) rc = odhs_softcore_coordination(sc, 0, &z);
+            if (rc) break;
+            acc[0] += sig[1] / rate / per; /* sigma_xy: row 0, column 1 */
+            acc[1] += p / rate / per;
+            acc[2] += z / per;
+        }
+        for (int a = 0; a < 3; ++a) blk[b][a] = acc[a];
+        blk[b][3] = 0.0;
+    }
+    out->cpu = bench_cpu() - c0;
+    odhs_softcore_counts(sc, &out->steps, NULL, NULL);
+    out->steps -= s0;
+    if (!rc) block_stats(blk, nb, out);
+    else fprintf(stderr, "batched: RD0 at rate %g failed: %s\n", rate, odhs_softcore_errmsg(sc));
+    odhs_softcore_destroy(sc);
+    return rc;
+}
+
+/* the hard-sphere settings and RD0 at each rate from the same warmed-up
+ * starts: stress per unit rate, its difference to the exact scheme's, cost
+ * per unit strain and its ratio to the batched default's */
+static int rd0(int dim, size_t n, int seeds, double w, const char *rate_list)
+{
+    double rates[16];
+    int nr = 0;
+    char buf[256];
+    snprintf(buf, sizeof buf, "%s", rate_list);
+    for (char *t = strtok(buf, ","); t && nr < 16; t = strtok(NULL, ","))
+        if (atof(t) > 0) rates[nr++] = atof(t);
+    if (nr == 0 || seeds < 1 || seeds > 16 || !(w >= 0.1) || w > 0.64 * 64) {
+        fprintf(stderr, "usage: batched --rd0 DIM N SEEDS STRAIN [RATES]\n");
+        return 2;
+    }
+    char cpu[256];
+    bench_cpu_model(cpu, sizeof cpu);
+    double la[3];
+    bench_loadavg(la);
+    printf("# hard spheres against RD0 at equal stress, %dD N = %zu, phi = %.2f; libodhs %s\n", dim, n,
+           dim == 2 ? 0.80 : 0.60, odhs_version_string());
+    printf("# machine: %s (%ld logical CPUs), load average at the start %.2f %.2f %.2f\n", cpu,
+           sysconf(_SC_NPROCESSORS_ONLN), la[0], la[1], la[2]);
+    printf("# per seed: batched compression, warm-up to strain 1 (batched); from that state each hard-sphere "
+           "setting (shear rate 1, solver auto) and RD0 (k_e = 1, k_d = 1 = 1/xi0, Euler at 0.1 tau_e, after its "
+           "own warm-up of strain %g) over strain %g, sampled every 0.01, 10 block means; stresses per unit "
+           "shear rate\n",
+           RD0_WARM, w);
+    printf("%4s %-17s %10s %9s %9s %13s %18s %18s %9s\n", "seed", "setting", "rate", "steps", "cpu_s",
+           "cpu_s/strain", "sxy/rate", "p/rate", "z");
+    int ns = S_COUNT + nr;
+    double val[32][3][16], cost[32][16];
+    int got[32] = {0};
+    double dmin = INFINITY;
+    for (int k = 0; k < seeds; ++k) {
+        odhs_system *sys;
+        if (warmed_seed(dim, n, k, &sys)) return 1;
+        if (k == 0) {
+            double *r = malloc(n * sizeof *r);
+            if (r && !odhs_system_get_radii(sys, r))
+                for (size_t i = 0; i < n; ++i) dmin = fmin(dmin, 2 * r[i]);
+            free(r);
+        }
+        for (int s = 0; s < ns; ++s) {
+            odhs_system *c;
+            stats r;
+            double rate = s < S_COUNT ? 1.0 : rates[s - S_COUNT];
+            if (odhs_system_clone(sys, &c)) return 1;
+            int rc = s < S_COUNT ? sample_run(c, s, w, 10, &r) : rd0_sample(c, rate, w, 10, &r);
+            odhs_system_destroy(c);
+            if (rc) continue;
+            char name[32];
+            snprintf(name, sizeof name, "%s", s < S_COUNT ? sname[s] : "RD0");
+            printf("%4d %-17s %10.1e %9llu %9.1f %13.1f %9.4f+-%7.4f %9.4f+-%7.4f %9.4f\n", k, name, rate,
+                   (unsigned long long)r.steps, r.cpu, r.cpu / w, r.mean[0], r.err[0], r.mean[1], r.err[1],
+                   r.mean[2]);
+            fflush(stdout);
+            for (int a = 0; a < 3; ++a) val[s][a][got[s]] = r.mean[a];
+            cost[s][got[s]++] = r.cpu / w;
+        }
+        odhs_system_destroy(sys);
+    }
+    printf("# pooled over seeds: mean +- standard error of the seed means (one seed: no error); difference of "
+           "sxy/rate to the exact scheme's in %% and in units of the combined error; cost per unit strain and its "
+           "ratio to the batched default's; gammadot tau_e with tau_e = k_d d_min^2 / k_e = %.4f\n",
+           dmin * dmin);
+    printf("%-17s %10s %10s %18s %18s %9s %9s %13s %10s\n", "setting", "rate", "rate*tau_e", "sxy/rate",
+           "p/rate", "dsxy_%", "dsxy/err", "cpu_s/strain", "/batched");
+    double mx, ex, eb, cb;
+    pooled(val[S_EXACT][0], got[S_EXACT], &mx, &ex);
+    pooled(cost[S_BATCHED], got[S_BATCHED], &cb, &eb);
+    for (int s = 0; s < ns; ++s) {
+        if (!got[s]) continue;
+        double m[2], e[2], c, ec;
+        for (int a = 0; a < 2; ++a) pooled(val[s][a], got[s], &m[a], &e[a]);
+        pooled(cost[s], got[s], &c, &ec);
+        double rate = s < S_COUNT ? 1.0 : rates[s - S_COUNT];
+        double d = got[S_EXACT] ? 100.0 * (m[0] / mx - 1.0) : NAN;
+        double z = got[S_EXACT] && s != S_EXACT ? (m[0] - mx) / sqrt(e[0] * e[0] + ex * ex) : NAN;
+        printf("%-17s %10.1e %10.2e %9.4f+-%7.4f %9.4f+-%7.4f %9.2f %9.1f %13.1f %10.2f\n",
+               s < S_COUNT ? sname[s] : "RD0", rate, s < S_COUNT ? NAN : rate * dmin * dmin, m[0], e[0], m[1],
+               e[1], d, z, c, got[S_BATCHED] ? c / cb : NAN);
+    }
+    printf("# RD0's cost per unit strain is that of 1 / (0.1 rate tau_e) Euler steps: it scales as 1 / rate\n");
     return 0;
 }
 
@@ -591,6 +750,9 @@ int main(int argc, char **argv)
 {
     if (argc > 5 && !strcmp(argv[1], "--accuracy"))
         return accuracy(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]));
+    if (argc > 5 && !strcmp(argv[1], "--rd0"))
+        return rd0(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]),
+                   argc > 6 ? argv[6] : "1e-3,3e-4,1e-4,3e-5,1e-5");
     if (argc > 3 && !strcmp(argv[1], "--plot")) return plot_table(argv[2], argv[3]);
     if (argc > 3 && !strcmp(argv[1], "--memory"))
         return memory(atoi(argv[2]), (size_t)atol(argv[3]), argc > 4 ? (size_t)atol(argv[4]) : 16384,
