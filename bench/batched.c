@@ -583,8 +583,9 @@ static int rd0(int dim, size_t n, int seeds, double w, const char *rate_list)
     snprintf(buf, sizeof buf, "%s", rate_list);
     for (char *t = strtok(buf, ","); t && nr < 16; t = strtok(NULL, ","))
         if (atof(t) > 0) rates[nr++] = atof(t);
-    if (nr == 0 || seeds < 1 || seeds > 16 || !(w >= 0.1) || w > 0.64 * 64) {
-        fprintf(stderr, "usage: batched --rd0 DIM N SEEDS STRAIN [RATES]\n");
+    if (nr == 0 || seeds < 1 || seeds > 16 || !(w >= 0.1) || w > 100 || fabs(10 * w - nearbyint(10 * w)) > 1e-9) {
+        fprintf(stderr, "usage: batched --rd0 DIM N SEEDS STRAIN [RATES] (STRAIN a multiple of 0.1: 10 blocks "
+                        "sampled every 0.01)\n");
         return 2;
     }
     char cpu[256];
