@@ -329,41 +329,66 @@ static void pooled(const double *v, int got, double *m, double *e)
     *e = got > 1 ? sqrt(*e / ((double)got * (got - 1))) : NAN;
 }
 
-/* shear sys over strain w, sampling sxy, p, z every 0.01 and collisions per
- * block; block means (nb blocks) -> mean and standard error */
+/* a route under sampling: advance to strain g past the window's start, then
+ * the sampled sxy, p, z and the collisions so far into v */
+typedef int (*advance_fn)(void *route, double g, double v[4]);
+
+/* sample a route every 0.01 of strain over w in nb blocks: block means of
+ * sxy, p, z and collisions per unit strain (from col0 at the start) -> mean
+ * and standard error */
+static int sample_blocks(advance_fn advance, void *route, double w, int nb, double col0, stats *out)
+{
+    double blk[64][4];
+    int per = (int)lround(w / 0.01) / nb, rc = 0;
+    for (int b = 0; b < nb && !rc; ++b) {
+        double acc[3] = {0, 0, 0}, v[4] = {0, 0, 0, col0};
+        for (int k = 0; k < per && !rc; ++k)
+            if (!(rc = advance(route, 0.01 * (b * per + k + 1), v)))
+                for (int a = 0; a < 3; ++a) acc[a] += v[a] / per;
+        for (int a = 0; a < 3; ++a) blk[b][a] = acc[a];
+        blk[b][3] = (v[3] - col0) / (0.01 * per);
+        col0 = v[3];
+    }
+    if (!rc) block_stats(blk, nb, out);
+    return rc;
+}
+
+typedef struct {
+    odhs_stepper *st;
+    double g0;
+} hs_route;
+
+static int hs_advance(void *route, double g, double v[4])
+{
+    hs_route *r = route;
+    uint64_t col = 0;
+    int rc = odhs_stepper_run_until_strain(r->st, r->g0 + g);
+    odhs_stepper_shear_stress(r->st, &v[0]);
+    odhs_stepper_pressure(r->st, &v[1]);
+    odhs_stepper_coordination(r->st, &v[2]);
+    odhs_stepper_counts(r->st, NULL, &col, NULL);
+    v[3] = (double)col;
+    return rc;
+}
+
+/* shear sys over strain w with a hard-sphere setting, sampled by
+ * sample_blocks */
 static int sample_run(odhs_system *sys, int setting, double w, int nb, stats *out)
 {
     odhs_solver *sol;
     odhs_driver *drv;
-    odhs_stepper *st = shear_stepper(sys, setting, &sol, &drv);
+    hs_route r = {shear_stepper(sys, setting, &sol, &drv), 0.0};
     memset(out, 0, sizeof *out);
-    double blk[64][4];
-    int ns = (int)lround(w / 0.01), per = ns / nb, rc = odhs_stepper_reset(st);
-    double c0 = bench_cpu(), g0 = 0.0;
+    int rc = odhs_stepper_reset(r.st);
+    double c0 = bench_cpu();
     uint64_t col0 = 0;
-    odhs_stepper_strain(st, &g0);
-    odhs_stepper_counts(st, NULL, &col0, NULL);
-    for (int b = 0; b < nb && !rc; ++b) {
-        double acc[3] = {0, 0, 0};
-        for (int k = 0; k < per && !rc; ++k) {
-            rc = odhs_stepper_run_until_strain(st, g0 + 0.01 * (b * per + k + 1));
-            double v[3];
-            odhs_stepper_shear_stress(st, &v[0]);
-            odhs_stepper_pressure(st, &v[1]);
-            odhs_stepper_coordination(st, &v[2]);
-            for (int a = 0; a < 3; ++a) acc[a] += v[a] / per;
-        }
-        uint64_t col;
-        odhs_stepper_counts(st, NULL, &col, NULL);
-        for (int a = 0; a < 3; ++a) blk[b][a] = acc[a];
-        blk[b][3] = (double)(col - col0) / (0.01 * per);
-        col0 = col;
-    }
+    odhs_stepper_strain(r.st, &r.g0);
+    odhs_stepper_counts(r.st, NULL, &col0, NULL);
+    if (!rc) rc = sample_blocks(hs_advance, &r, w, nb, (double)col0, out);
     out->cpu = bench_cpu() - c0;
-    odhs_stepper_counts(st, &out->steps, NULL, NULL);
-    block_stats(blk, nb, out);
-    if (rc) fprintf(stderr, "batched: %s failed: %s\n", sname[setting], odhs_stepper_errmsg(st));
-    odhs_stepper_destroy(st);
+    odhs_stepper_counts(r.st, &out->steps, NULL, NULL);
+    if (rc) fprintf(stderr, "batched: %s failed: %s\n", sname[setting], odhs_stepper_errmsg(r.st));
+    odhs_stepper_destroy(r.st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);
     return rc;
@@ -530,45 +555,49 @@ static int accuracy(int dim, size_t n, int seeds, double w)
 /* ---- --rd0: the soft-core route at equal stress ------------------------------ */
 #define RD0_WARM 0.1 /* strain of RD0's own transient from the hard-sphere state */
 
+typedef struct {
+    odhs_softcore *sc;
+    double rate;
+} rd0_route;
+
+/* RD0's stresses per unit rate; no collisions */
+static int rd0_advance(void *route, double g, double v[4])
+{
+    rd0_route *r = route;
+    double sig[9], p = 0, z = 0;
+    int rc = odhs_softcore_run_until_strain(r->sc, RD0_WARM + g);
+    if (!rc) rc = odhs_softcore_stress(r->sc, ODHS_SOFTCORE_STRESS_TOTAL, sig);
+    if (!rc) rc = odhs_softcore_pressure(r->sc, &p);
+    if (!rc) rc = odhs_softcore_coordination(r->sc, 0, &z);
+    if (rc) return rc;
+    v[0] = sig[1] / r->rate; /* sigma_xy: row 0, column 1 */
+    v[1] = p / r->rate;
+    v[2] = z;
+    return ODHS_OK;
+}
+
 /* RD0 with the library's defaults (k_e = 1, k_d = 1 = 1/xi0, explicit Euler
  * at 0.1 tau_e) at shear rate `rate` from sys (moved in place): warm-up
- * RD0_WARM, then sxy / rate, p / rate and z (overlapping neighbours) sampled
- * every 0.01 of strain over w in nb blocks; CPU and steps of the window */
+ * RD0_WARM, then sampled by sample_blocks over w (z counts overlapping
+ * neighbours); CPU and steps of the window */
 static int rd0_sample(odhs_system *sys, double rate, double w, int nb, stats *out)
 {
-    odhs_softcore *sc;
+    rd0_route r = {NULL, rate};
     memset(out, 0, sizeof *out);
-    int rc = odhs_softcore_create(sys, &sc);
+    int rc = odhs_softcore_create(sys, &r.sc);
     if (rc) return rc;
-    rc = odhs_softcore_set_model(sc, ODHS_SOFTCORE_RD0);
-    if (!rc) rc = odhs_softcore_set_shear_rate(sc, rate);
-    if (!rc) rc = odhs_softcore_run_until_strain(sc, RD0_WARM);
-    double blk[64][4], c0 = bench_cpu();
-    int ns = (int)lround(w / 0.01), per = ns / nb;
+    rc = odhs_softcore_set_model(r.sc, ODHS_SOFTCORE_RD0);
+    if (!rc) rc = odhs_softcore_set_shear_rate(r.sc, rate);
+    if (!rc) rc = odhs_softcore_run_until_strain(r.sc, RD0_WARM);
+    double c0 = bench_cpu();
     uint64_t s0 = 0;
-    odhs_softcore_counts(sc, &s0, NULL, NULL);
-    for (int b = 0; b < nb && !rc; ++b) {
-        double acc[3] = {0, 0, 0};
-        for (int k = 0; k < per && !rc; ++k) {
-            double sig[9], p = 0, z = 0;
-            rc = odhs_softcore_run_until_strain(sc, RD0_WARM + 0.01 * (b * per + k + 1));
-            if (!rc) rc = odhs_softcore_stress(sc, ODHS_SOFTCORE_STRESS_TOTAL, sig);
-            if (!rc) rc = odhs_softcore_pressure(sc, &p);
-            if (!rc) rc = odhs_softcore_coordination(sc, 0, &z);
-            if (rc) break;
-            acc[0] += sig[1] / rate / per; /* sigma_xy: row 0, column 1 */
-            acc[1] += p / rate / per;
-            acc[2] += z / per;
-        }
-        for (int a = 0; a < 3; ++a) blk[b][a] = acc[a];
-        blk[b][3] = 0.0;
-    }
+    odhs_softcore_counts(r.sc, &s0, NULL, NULL);
+    if (!rc) rc = sample_blocks(rd0_advance, &r, w, nb, 0.0, out);
     out->cpu = bench_cpu() - c0;
-    odhs_softcore_counts(sc, &out->steps, NULL, NULL);
+    odhs_softcore_counts(r.sc, &out->steps, NULL, NULL);
     out->steps -= s0;
-    if (!rc) block_stats(blk, nb, out);
-    else fprintf(stderr, "batched: RD0 at rate %g failed: %s\n", rate, odhs_softcore_errmsg(sc));
-    odhs_softcore_destroy(sc);
+    if (rc) fprintf(stderr, "batched: RD0 at rate %g failed: %s\n", rate, odhs_softcore_errmsg(r.sc));
+    odhs_softcore_destroy(r.sc);
     return rc;
 }
 
