@@ -29,6 +29,14 @@
  *          collisions per unit strain of exact and batched runs (block
  *          means, SEEDS starts, over STRAIN each), and the convergence of
  *          a trajectory over strain 0.01 as the tolerance and the step fall
+ *          (ODHS_BENCH_FIRST_SEED=K: seeds K .. K+SEEDS-1, the trajectory
+ *          only with seed 0; ODHS_BENCH_SKIP_TRAJECTORY=1 skips it;
+ *          ODHS_BENCH_SETTINGS=exact,batched,tight or a subset)
+ *        batched --from FILE.xyz STRAIN [exact|batched|tight]: one setting
+ *          over STRAIN from a saved start: CPU time, steps, events, solves,
+ *          drift-correction passes, factorisations (for profiles)
+ *        batched --pool FILE...: the pooled lines over the seed rows of
+ *          several --accuracy outputs (seeds split across processes)
  *        batched --rd0 DIM N SEEDS STRAIN [RATES]: the same starts sheared
  *          by the hard-sphere settings and by the library's RD0 at each
  *          rate (default 1e-3,3e-4,1e-4,3e-5,1e-5): stress per unit rate
@@ -462,6 +470,31 @@ static int warmed_seed(int dim, size_t n, int k, odhs_system **out)
     return rc != 0;
 }
 
+/* the pooled lines of per-seed means pool[setting][quantity][seed] */
+static void print_pooled(double pool[S_COUNT][4][16], const int got[S_COUNT])
+{
+    printf("# pooled over seeds (mean +- standard error of the seed means); difference to exact in units of the "
+           "combined error\n");
+    for (int s = 0; s < S_COUNT; ++s) {
+        if (got[s] < 2) continue;
+        printf("%-17s", sname[s]);
+        for (int a = 0; a < 4; ++a) {
+            double m[S_COUNT] = {0}, e[S_COUNT] = {0};
+            for (int q = 0; q < S_COUNT; ++q) {
+                if (got[q] >= 2) pooled(pool[q][a], got[q], &m[q], &e[q]);
+            }
+            const char *name = a == 0 ? "sxy" : a == 1 ? "p" : a == 2 ? "z" : "coll/strain";
+            if (got[S_EXACT] < 2) { /* no exact runs to compare with */
+                printf("  %s %.4g+-%.2g", name, m[s], e[s]);
+                continue;
+            }
+            double z = s == S_EXACT ? 0.0 : (m[s] - m[S_EXACT]) / sqrt(e[s] * e[s] + e[S_EXACT] * e[S_EXACT]);
+            printf("  %s %.4g+-%.2g (%+.1f sigma)", name, m[s], e[s], z);
+        }
+        printf("\n");
+    }
+}
+
 static int accuracy(int dim, size_t n, int seeds, double w)
 {
     double phi = dim == 2 ? 0.80 : 0.60;
@@ -476,11 +509,27 @@ static int accuracy(int dim, size_t n, int seeds, double w)
     int got[S_COUNT] = {0};
     double *x0 = NULL;
     odhs_system *first = NULL;
-    for (int k = 0; k < seeds; ++k) {
+    const char *fs = getenv("ODHS_BENCH_FIRST_SEED"), *skip = getenv("ODHS_BENCH_SKIP_TRAJECTORY");
+    const int k0 = fs ? atoi(fs) : 0, with_b = k0 == 0 && !(skip && *skip && strcmp(skip, "0"));
+    /* ODHS_BENCH_SETTINGS: a subset of exact,batched,tight (default all) */
+    const char *only = getenv("ODHS_BENCH_SETTINGS");
+    int run_s[S_COUNT];
+    for (int s = 0; s < S_COUNT; ++s) {
+        static const char *const key[S_COUNT] = {"exact", "batched", "tight"};
+        const char *hit = only ? strstr(only, key[s]) : NULL;
+        size_t len = strlen(key[s]);
+        run_s[s] = !only || (hit && (hit == only || hit[-1] == ',') && (hit[len] == ',' || hit[len] == 0));
+    }
+    if (k0 < 0 || seeds > 16) {
+        fprintf(stderr, "batched --accuracy: ODHS_BENCH_FIRST_SEED must be >= 0 and SEEDS <= 16\n");
+        return 2;
+    }
+    for (int k = k0; k < k0 + seeds; ++k) {
         odhs_system *sys;
         if (warmed_seed(dim, n, k, &sys)) return 1;
-        if (k == 0) odhs_system_clone(sys, &first);
+        if (k == 0 && with_b) odhs_system_clone(sys, &first);
         for (int s = 0; s < S_COUNT; ++s) {
+            if (!run_s[s]) continue;
             odhs_system *c;
             odhs_system_clone(sys, &c);
             stats r;
@@ -496,22 +545,8 @@ static int accuracy(int dim, size_t n, int seeds, double w)
         }
         odhs_system_destroy(sys);
     }
-    printf("# pooled over seeds (mean +- standard error of the seed means); difference to exact in units of the "
-           "combined error\n");
-    for (int s = 0; s < S_COUNT; ++s) {
-        if (got[s] < 2) continue;
-        printf("%-17s", sname[s]);
-        for (int a = 0; a < 4; ++a) {
-            double m[S_COUNT] = {0}, e[S_COUNT] = {0};
-            for (int q = 0; q < S_COUNT; ++q) {
-                if (got[q] >= 2) pooled(pool[q][a], got[q], &m[q], &e[q]);
-            }
-            double z = s == S_EXACT ? 0.0 : (m[s] - m[S_EXACT]) / sqrt(e[s] * e[s] + e[S_EXACT] * e[S_EXACT]);
-            printf("  %s %.4g+-%.2g (%+.1f sigma)", a == 0 ? "sxy" : a == 1 ? "p" : a == 2 ? "z" : "coll/strain", m[s],
-                   e[s], z);
-        }
-        printf("\n");
-    }
+    print_pooled(pool, got);
+    if (!with_b) return 0;
     /* (b) convergence over strain 0.01 from the first seed's warmed-up state */
     size_t nd = n * (size_t)dim;
     double *xr = malloc(nd * sizeof *xr), *x = malloc(nd * sizeof *x), cpu;
@@ -550,6 +585,91 @@ static int accuracy(int dim, size_t n, int seeds, double w)
     free(x);
     odhs_system_destroy(first);
     return 0;
+}
+
+/* --pool FILE...: the pooled lines over the per-seed rows of several
+ * --accuracy outputs (seeds run in separate processes) */
+static int pool_files(int nf, char **files)
+{
+    double pool[S_COUNT][4][16];
+    int got[S_COUNT] = {0};
+    for (int f = 0; f < nf; ++f) {
+        FILE *in = fopen(files[f], "r");
+        if (!in) {
+            perror(files[f]);
+            return 1;
+        }
+        char line[512];
+        while (fgets(line, sizeof line, in)) {
+            int seed, off = 0;
+            if (line[0] == '#' || sscanf(line, "%d %n", &seed, &off) != 1) continue;
+            for (int s = 0; s < S_COUNT; ++s) {
+                size_t len = strlen(sname[s]);
+                unsigned long long steps;
+                double cpu, v[4], e[4];
+                if (strncmp(line + off, sname[s], len)) continue;
+                if (sscanf(line + off + len, "%llu %lf %lf+-%lf %lf+-%lf %lf+-%lf %lf+-%lf", &steps, &cpu, &v[0], &e[0],
+                           &v[1], &e[1], &v[2], &e[2], &v[3], &e[3]) != 10 ||
+                    got[s] >= 16) {
+                    fprintf(stderr, "batched --pool: %s: unreadable row: %s", files[f], line);
+                    fclose(in);
+                    return 1;
+                }
+                for (int a = 0; a < 4; ++a) pool[s][a][got[s]] = v[a];
+                got[s]++;
+            }
+        }
+        fclose(in);
+    }
+    printf("# pooled over the seed rows of %d file(s): %d exact, %d batched, %d tight runs\n", nf, got[S_EXACT],
+           got[S_BATCHED], got[S_TIGHT]);
+    print_pooled(pool, got);
+    return got[S_EXACT] < 2;
+}
+
+/* ---- --from: one setting over a window from a saved start ------------------ */
+/* The cost of a window of strain w from the configuration in path (extended
+ * XYZ or LAMMPS data) with one setting, and where it went: steps, events,
+ * force solves of the contact problems, drift corrections (passes, pairs
+ * closed), factorisations; the stress at the end. Profiles (perf) run this. */
+static int from_file(const char *path, double w, const char *setting)
+{
+    int s = !strcmp(setting, "exact") ? S_EXACT : !strcmp(setting, "tight") ? S_TIGHT : S_BATCHED;
+    odhs_system *sys;
+    char eb[256];
+    if (odhs_xyz_read(path, &sys, eb, sizeof eb)) {
+        fprintf(stderr, "batched --from: %s\n", eb);
+        return 1;
+    }
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *st = shear_stepper(sys, s, &sol, &drv);
+    double c0 = bench_cpu(), g0 = 0.0, cr;
+    int rc = odhs_stepper_reset(st);
+    cr = bench_cpu() - c0;
+    odhs_stepper_strain(st, &g0);
+    if (!rc) rc = odhs_stepper_run_until_strain(st, g0 + w);
+    double cpu = bench_cpu() - c0 - cr, sxy = NAN, fact = 0, orders = 0;
+    uint64_t steps = 0, col = 0, op = 0, bsol = 0, corr = 0, passes = 0, closed = 0;
+    odhs_stepper_counts(st, &steps, &col, &op);
+    odhs_stepper_batched_stats(st, NULL, NULL, &bsol);
+    odhs_stepper_correction_stats(st, &corr, &passes, &closed);
+    odhs_solver_get_stat(sol, "factorizations", &fact);
+    odhs_solver_get_stat(sol, "analyses", &orders);
+    if (!rc) odhs_stepper_shear_stress(st, &sxy);
+    printf("# libodhs %s, %s, N = %zu, strain %g from %s (status %d%s%s)\n", odhs_version_string(), sname[s],
+           odhs_system_count(sys), w, path, rc, rc ? ": " : "", rc ? odhs_stepper_errmsg(st) : "");
+    printf("cpu_s %.2f reset_s %.2f steps %llu collisions %llu openings %llu contact_problem_solves %llu "
+           "corrections %llu correction_passes %llu correction_closed %llu factorizations %.0f analyses %.0f "
+           "sxy_end %.6f\n",
+           cpu, cr, (unsigned long long)steps, (unsigned long long)col, (unsigned long long)op,
+           (unsigned long long)bsol, (unsigned long long)corr, (unsigned long long)passes, (unsigned long long)closed,
+           fact, orders, sxy);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(sys);
+    return rc != 0;
 }
 
 /* ---- --rd0: the soft-core route at equal stress ------------------------------ */
@@ -784,6 +904,8 @@ int main(int argc, char **argv)
         return rd0(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]),
                    argc > 6 ? argv[6] : "1e-3,3e-4,1e-4,3e-5,1e-5");
     if (argc > 3 && !strcmp(argv[1], "--plot")) return plot_table(argv[2], argv[3]);
+    if (argc > 2 && !strcmp(argv[1], "--pool")) return pool_files(argc - 2, argv + 2);
+    if (argc > 3 && !strcmp(argv[1], "--from")) return from_file(argv[2], atof(argv[3]), argc > 4 ? argv[4] : "batched");
     if (argc > 3 && !strcmp(argv[1], "--memory"))
         return memory(atoi(argv[2]), (size_t)atol(argv[3]), argc > 4 ? (size_t)atol(argv[4]) : 16384,
                       argc > 5 ? atoi(argv[5]) : 5);

@@ -1836,6 +1836,10 @@ static int huge_rate_case(void)
       uint64_t a; return odhs_stepper_batched_stats(NULL, &a, &a, &a);)                                        \
     X(st_batched_stats_all_null, odhs_stepper_batched_stats, ODHS_OK, NOALT, H_NONE, 0,                        \
       return odhs_stepper_batched_stats(w->run, NULL, NULL, NULL);)                                            \
+    X(st_correction_stats_null, odhs_stepper_correction_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                  \
+      uint64_t a; return odhs_stepper_correction_stats(NULL, &a, &a, &a);)                                     \
+    X(st_correction_stats_all_null, odhs_stepper_correction_stats, ODHS_OK, NOALT, H_NONE, 0,                  \
+      return odhs_stepper_correction_stats(w->run, NULL, NULL, NULL);)                                         \
     X(st_rewire_stats_null, odhs_stepper_rewire_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                          \
       uint64_t c; return odhs_stepper_rewire_stats(NULL, &c);)                                                 \
     X(st_rewire_stats_out_null, odhs_stepper_rewire_stats, ODHS_E_NULL, NOALT, H_NONE, 0,                      \

@@ -161,7 +161,9 @@ ODHS_API int odhs_stepper_reset(odhs_stepper *st);
  * Apply the drift correction of Sect. IV C now, repeated until the contact
  * gaps are at round-off (a few passes: each leaves a second-order residual),
  * then re-solve and rewire; e.g. before saving a configuration. Events it
- * causes go to the event callback. Returns like odhs_stepper_step.
+ * causes go to the event callback. Returns like odhs_stepper_step. Under
+ * ODHS_INTEGRATOR_BATCHED a pass takes every pair its motion would close
+ * at once (since 0.2.15; odhs_stepper_correction_stats).
  */
 ODHS_API int odhs_stepper_correct(odhs_stepper *st);
 
@@ -267,6 +269,19 @@ ODHS_API int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejec
  *  stepper was created or read from a checkpoint. Since 0.2.14. */
 ODHS_API int odhs_stepper_batched_stats(const odhs_stepper *st, uint64_t *batched_steps, uint64_t *exact_steps,
                                         uint64_t *solves);
+/** Counters of the drift correction (Sect. IV C; any output may be NULL):
+ *  corrections applied (after steps and by odhs_stepper_correct), their
+ *  passes (one force solve each) and the pairs the passes closed (a
+ *  correction's motion that meets a pair adds it as a contact). With the
+ *  exact schemes a pass stops at the first pair its motion meets, so
+ *  closing k pairs takes at least k passes; with ODHS_INTEGRATOR_BATCHED
+ *  every pair the pass's motion would close joins at once (since 0.2.15),
+ *  as the step's contact problem closes its pairs, and the end gaps of a
+ *  batched step (second order in h, ~1e-3 of a diameter at the default
+ *  tolerance) take a few passes however many pairs they close. Counted
+ *  since the stepper was created or read from a checkpoint. Since 0.2.15. */
+ODHS_API int odhs_stepper_correction_stats(const odhs_stepper *st, uint64_t *corrections, uint64_t *passes,
+                                           uint64_t *closed);
 /** Rewirings that the anti-cycling method finished (since 0.2.2). The
  *  paper's rule (drop the most negative force, re-connect the most
  *  approaching removed pair; Sect. IV B) can cycle on degenerate networks

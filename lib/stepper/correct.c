@@ -132,6 +132,7 @@ static int correct_passes(odhs_stepper *st, int *added, out_set *o)
         prev = gmax;
         memset(st->cx, 0, nc * sizeof *st->cx);
         memset(Z, 0, sizeof Z);
+        st->ncorr_passes++;
         if (excess == 1) {
             /* fixed pressure, flowing on an isostatic network: N is singular,
              * but the volume is free. The gap component along f0 goes with an
@@ -157,15 +158,28 @@ static int correct_passes(odhs_stepper *st, int *added, out_set *o)
         }
         odhs__net_ST(net, st->cx, st->tmp);
         for (size_t k = 0; k < st->nd; ++k) st->tmp[k] = -st->tmp[k];
-        size_t pi, pj;
+        size_t pi, pj, nv = 0;
         double t = odhs__st_predict(st, Z, st->tmp, 1.0, 0.0, 0, 0, &pi, &pj);
+        /* batched: every pair the chord closes joins at once (a block pass;
+         * batched.c), unless the first is a wall or contacts are left out */
+        const int block = st->integrator == ODHS_INTEGRATOR_BATCHED && pi != SIZE_MAX && pj < st->n && o->n == 0;
+        if (block && (s = odhs__st_batched_chord_pairs(st, Z, st->tmp, &nv))) return s;
         odhs__st_advance(st, Z, st->tmp, t);
-        if (pi != SIZE_MAX) {
+        if (nv) {
+            for (size_t q = 0; q < nv; ++q) {
+                size_t c;
+                if ((s = odhs__st_add_contact(st, st->bviol[q].i, st->bviol[q].j, &c))) return s;
+                st->ncorr_closed++;
+            }
+            *added = 1;
+            prev = INFINITY;
+        } else if (pi != SIZE_MAX) {
             /* a left-out contact met again goes back in (it is no event) */
             if ((s = put_back(st, o, pi, pj)) < 0) return s;
             size_t c;
             if (s == 0) {
                 if ((s = odhs__st_add_contact(st, pi, pj, &c))) return s;
+                st->ncorr_closed++;
                 *added = 1;
             }
             prev = INFINITY; /* new contact: a new problem */
@@ -178,6 +192,7 @@ static int correct_passes(odhs_stepper *st, int *added, out_set *o)
 int odhs__st_correct(odhs_stepper *st, int *added)
 {
     out_set o = {.n = 0, .ns = 0};
+    st->ncorr++;
     int s = correct_passes(st, added, &o);
     if (o.n) {
         st->corr_skipped = 1; /* the rest after the rewiring (step.c) */

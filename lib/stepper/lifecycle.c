@@ -160,6 +160,15 @@ int odhs_stepper_batched_stats(const odhs_stepper *st, uint64_t *batched_steps, 
     return ODHS_OK;
 }
 
+int odhs_stepper_correction_stats(const odhs_stepper *st, uint64_t *corrections, uint64_t *passes, uint64_t *closed)
+{
+    if (!st) return ODHS_E_NULL;
+    if (corrections) *corrections = st->ncorr;
+    if (passes) *passes = st->ncorr_passes;
+    if (closed) *closed = st->ncorr_closed;
+    return ODHS_OK;
+}
+
 int odhs_stepper_adaptive_stats(const odhs_stepper *st, uint64_t *rejected, double *h)
 {
     if (!st) return ODHS_E_NULL;

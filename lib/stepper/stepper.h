@@ -42,6 +42,7 @@ struct odhs_stepper {
     double bh;        /* > 0 while the batched step's contact problem is solved:
                        * the step, over which each contact's gap closes (forces.c) */
     uint64_t nbatched, nbatched_exact, nbatched_solves; /* batched.c (not checkpointed) */
+    uint64_t ncorr, ncorr_passes, ncorr_closed;         /* correct.c (not checkpointed) */
     odhs_change *bviol; /* batched.c: the pairs a contact problem closes */
     size_t bviolcap;
     double h;         /* adaptive: current step in units of tau */
@@ -288,6 +289,9 @@ int odhs__st_correct_isostatic(odhs_stepper *st, double *Z);
 int odhs__st_rewire(odhs_stepper *st);
 /* the same network by block updates (many events at once; rewire.c) */
 int odhs__st_rewire_block(odhs_stepper *st);
+/* batched.c: the pairs a drift-correction chord closes within its unit time
+ * (into st->bviol, by index) */
+int odhs__st_batched_chord_pairs(odhs_stepper *st, const double *G, const double *vel, size_t *nv);
 int odhs__st_open_contact(odhs_stepper *st, size_t k, double *x);
 int odhs__st_jam_finish(odhs_stepper *st);
 

@@ -34,8 +34,8 @@ from .errors import (BoxError, CallbackError, DimensionError, EmptyError, Error,
 from .io import (Trajectory, count_xyz_frames, parse_lammps_data, parse_xyz, read_lammps_data, read_xyz,
                  traj_format_for, write_contacts, write_contacts_csv, write_lammps_data, write_svg, write_xyz)
 from .network import Network
-from .records import (AdaptiveStats, BatchedStats, Certificate, Constrained, Contacts, Counts, Errors, Event, JamLpReport,
-                      OscillatoryShear, Propulsion, RunLimits, Settings, SoftcoreCounts, SolverInfo, StepInfo)
+from .records import (AdaptiveStats, BatchedStats, Certificate, CorrectionStats, Constrained, Contacts, Counts, Errors,
+                      Event, JamLpReport, OscillatoryShear, Propulsion, RunLimits, Settings, SoftcoreCounts, SolverInfo, StepInfo)
 from .softcore import Softcore
 from .solver import Solver, SolverBackend, available_solvers
 from .stepper import Stepper, parse_checkpoint, read_checkpoint
@@ -94,7 +94,7 @@ __all__ = [
     "status_name", "last_error",
     "EventKind", "ContactKind", "Integrator", "Oscillation", "Feature", "WallShape", "TrajFormat",
     "SoftcoreModel", "SoftcoreIntegrator", "Minimiser", "StressPart", "SolverFlag",
-    "Event", "StepInfo", "Counts", "Settings", "RunLimits", "AdaptiveStats", "BatchedStats", "Errors", "Contacts", "Constrained",
+    "Event", "StepInfo", "Counts", "Settings", "RunLimits", "AdaptiveStats", "BatchedStats", "CorrectionStats", "Errors", "Contacts", "Constrained",
     "Certificate", "JamLpReport", "Propulsion", "OscillatoryShear", "SoftcoreCounts", "SolverInfo", "Separation", "Pairs",
     "version", "version_number", "header_version", "library_path",
 ]

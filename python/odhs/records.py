@@ -30,6 +30,10 @@ BatchedStats = collections.namedtuple("BatchedStats", "batched_steps exact_steps
 BatchedStats.__doc__ = ("Batched-integrator counters: accepted batched steps, steps taken by the exact scheme instead, "
                         "force solves of the steps' contact problems.")
 
+CorrectionStats = collections.namedtuple("CorrectionStats", "corrections passes closed")
+CorrectionStats.__doc__ = ("Drift-correction counters: corrections applied, their passes (one force solve each), pairs "
+                           "the passes closed.")
+
 Errors = collections.namedtuple("Errors", "contact_gap overlap")
 Errors.__doc__ = """Largest |gap|/(a_i+a_j) over contacts and largest overlap -gap/(a_i+a_j) over all
 pairs (odhs_stepper_errors)."""

@@ -17,8 +17,8 @@ from .constants import EventKind, Feature, Integrator, to_enum
 from .driver import Driver
 from .errors import last_error, make_error
 from .network import Network
-from .records import (AdaptiveStats, BatchedStats, Certificate, Contacts, Counts, Errors, Event, JamLpReport, RunLimits, Settings,
-                      StepInfo)
+from .records import (AdaptiveStats, BatchedStats, Certificate, CorrectionStats, Contacts, Counts, Errors, Event,
+                      JamLpReport, RunLimits, Settings, StepInfo)
 from .solver import Solver
 from .system import System
 
@@ -387,6 +387,16 @@ class Stepper(Owned):
         if rc:
             self._err(rc, "Stepper.batched_stats")
         return BatchedStats(int(a[0]), int(b[0]), int(c[0]))
+
+    @property
+    def correction_stats(self):
+        """CorrectionStats(corrections, passes, closed) of the drift
+        correction (odhs_stepper_correction_stats; since 0.2.15)."""
+        a, b, c = ffi.new("uint64_t *"), ffi.new("uint64_t *"), ffi.new("uint64_t *")
+        rc = lib.odhs_stepper_correction_stats(self._p or self._closed(), a, b, c)
+        if rc:
+            self._err(rc, "Stepper.correction_stats")
+        return CorrectionStats(int(a[0]), int(b[0]), int(c[0]))
 
     @property
     def rewire_count(self):

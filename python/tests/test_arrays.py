@@ -212,5 +212,7 @@ def test_batched_integrator(run):
     st.run_until_strain(0.05)
     b = st.batched_stats
     assert b.batched_steps > 0 and b.solves >= b.batched_steps
+    c = st.correction_stats  # a correction after every step
+    assert c.corrections >= b.batched_steps and c.passes >= 1 and c.closed >= 0
     assert st.errors.overlap <= 1e-12
     assert st.power == pytest.approx(st.dissipation, rel=1e-9)
