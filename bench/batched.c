@@ -628,7 +628,8 @@ static int pool_files(int nf, char **files)
     printf("# pooled over the seed rows of %d file(s): %d exact, %d batched, %d tight runs\n", nf, got[S_EXACT],
            got[S_BATCHED], got[S_TIGHT]);
     print_pooled(pool, got);
-    return got[S_EXACT] < 2;
+    /* nothing to pool: no setting with two seeds */
+    return got[S_EXACT] < 2 && got[S_BATCHED] < 2 && got[S_TIGHT] < 2;
 }
 
 /* ---- --from: one setting over a window from a saved start ------------------ */
@@ -653,13 +654,13 @@ static int from_file(const char *path, double w, const char *setting)
     cr = bench_cpu() - c0;
     odhs_stepper_strain(st, &g0);
     if (!rc) rc = odhs_stepper_run_until_strain(st, g0 + w);
-    double cpu = bench_cpu() - c0 - cr, sxy = NAN, fact = 0, orders = 0;
+    double cpu = bench_cpu() - c0 - cr, sxy = NAN, fact = 0, analyses = 0;
     uint64_t steps = 0, col = 0, op = 0, bsol = 0, corr = 0, passes = 0, closed = 0;
     odhs_stepper_counts(st, &steps, &col, &op);
     odhs_stepper_batched_stats(st, NULL, NULL, &bsol);
     odhs_stepper_correction_stats(st, &corr, &passes, &closed);
     odhs_solver_get_stat(sol, "factorizations", &fact);
-    odhs_solver_get_stat(sol, "analyses", &orders);
+    odhs_solver_get_stat(sol, "analyses", &analyses);
     if (!rc) odhs_stepper_shear_stress(st, &sxy);
     printf("# libodhs %s, %s, N = %zu, strain %g from %s (status %d%s%s)\n", odhs_version_string(), sname[s],
            odhs_system_count(sys), w, path, rc, rc ? ": " : "", rc ? odhs_stepper_errmsg(st) : "");
@@ -668,7 +669,7 @@ static int from_file(const char *path, double w, const char *setting)
            "sxy_end %.6f\n",
            cpu, cr, (unsigned long long)steps, (unsigned long long)col, (unsigned long long)op,
            (unsigned long long)bsol, (unsigned long long)corr, (unsigned long long)passes, (unsigned long long)closed,
-           fact, orders, sxy);
+           fact, analyses, sxy);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);

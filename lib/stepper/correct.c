@@ -160,9 +160,11 @@ static int correct_passes(odhs_stepper *st, int *added, out_set *o)
         for (size_t k = 0; k < st->nd; ++k) st->tmp[k] = -st->tmp[k];
         size_t pi, pj, nv = 0;
         double t = odhs__st_predict(st, Z, st->tmp, 1.0, 0.0, 0, 0, &pi, &pj);
-        /* batched: every pair the chord closes joins at once (a block pass;
-         * batched.c), unless the first is a wall or contacts are left out */
-        const int block = st->integrator == ODHS_INTEGRATOR_BATCHED && pi != SIZE_MAX && pj < st->n && o->n == 0;
+        /* a step type whose end works in blocks (batched): every pair the
+         * chord closes joins at once, unless the first is a wall or
+         * contacts are left out */
+        const int block = pi != SIZE_MAX && pj < st->n && o->n == 0 &&
+                          odhs__step_type_find(st->integrator)->block_rewire;
         if (block && (s = odhs__st_batched_chord_pairs(st, Z, st->tmp, &nv))) return s;
         odhs__st_advance(st, Z, st->tmp, t);
         if (nv) {

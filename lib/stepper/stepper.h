@@ -232,7 +232,10 @@ typedef struct {
     double tol_default; /* the tolerance this integrator starts with */
     double dt_default;  /* and its dt (odhs_stepper_set_dt) */
     double h_first;     /* its first adaptive step, relative to dt */
-    int block_rewire;   /* the step's end rewires by block updates (odhs__st_rewire_block) */
+    /* the step's end rewires by block updates (odhs__st_rewire_block), and
+     * a pass of its drift correction closes every pair its motion meets at
+     * once (odhs__st_batched_chord_pairs; correct.c) */
+    int block_rewire;
 } odhs__step_type;
 
 extern const odhs__step_type odhs__step_euler; /* euler.c: the paper's scheme */
