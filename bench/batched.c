@@ -35,6 +35,15 @@
  *        batched --from FILE.xyz STRAIN [exact|batched|tight]: one setting
  *          over STRAIN from a saved start: CPU time, steps, events, solves,
  *          drift-correction passes, factorisations (for profiles)
+ *        batched --paired DIM N STARTS WINDOW [STRIDE]: from STARTS states
+ *          of one batched run (STRIDE apart, default 0.2; seed
+ *          ODHS_BENCH_FIRST_SEED), the exact defaults, Heun at tol 1e-9 and
+ *          the batched step at tol 1e-2 .. 1e-6 over the same window of
+ *          strain WINDOW: the paired differences of the window means of
+ *          sxy, p, z and collisions per unit strain (the batched bias of
+ *          one stretch of trajectory, without the noise of separate runs)
+ *        batched --pool-paired FILE...: the same summary over the starts
+ *          of several --paired outputs
  *        batched --pool FILE...: the pooled lines over the seed rows of
  *          several --accuracy outputs (seeds split across processes)
  *        batched --rd0 DIM N SEEDS STRAIN [RATES]: the same starts sheared
@@ -677,6 +686,187 @@ static int from_file(const char *path, double w, const char *setting)
     return rc != 0;
 }
 
+/* ---- --paired: short windows from common starts ---------------------------- */
+/* The batched bias, local or structural: from STARTS states of one steady
+ * run (a batched carrier, its states STRIDE apart), every setting below over
+ * the same window of strain W, sampled every 0.01 of strain as --accuracy
+ * does; per setting the mean over starts of its window means minus the
+ * exact defaults' (paired), with the standard error over starts. A bias set
+ * by each step shows here over short windows; one the trajectory builds up
+ * over strain does not. */
+typedef struct {
+    const char *name;
+    int integ;
+    double tol; /* 0: the integrator's default */
+} psetting;
+
+static const psetting pset[] = {
+    {"exact (defaults)", -1, 0.0},           {"exact Heun tol 1e-9", ODHS_INTEGRATOR_HEUN, 1e-9},
+    {"batched tol 1e-2", ODHS_INTEGRATOR_BATCHED, 1e-2}, {"batched tol 1e-3", ODHS_INTEGRATOR_BATCHED, 1e-3},
+    {"batched tol 1e-4", ODHS_INTEGRATOR_BATCHED, 1e-4}, {"batched tol 1e-5", ODHS_INTEGRATOR_BATCHED, 1e-5},
+    {"batched tol 1e-6", ODHS_INTEGRATOR_BATCHED, 1e-6},
+};
+#define NPSET ((int)(sizeof pset / sizeof pset[0]))
+
+/* one window of strain w of setting q from start: window means of sxy, p, z
+ * and collisions per unit strain into v; steps, cpu */
+static int paired_window(const odhs_system *start, int q, double w, double v[4], uint64_t *steps, double *cpu)
+{
+    odhs_system *sys;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    if (odhs_system_clone(start, &sys)) return 1;
+    hs_route r = {shear_stepper(sys, S_EXACT, &sol, &drv), 0.0};
+    int rc = pset[q].integ >= 0 ? odhs_stepper_set_integrator(r.st, pset[q].integ) : ODHS_OK;
+    if (!rc && pset[q].tol > 0) rc = odhs_stepper_set_tolerance(r.st, pset[q].tol);
+    if (!rc) rc = odhs_stepper_reset(r.st);
+    double c0 = bench_cpu(), acc[3] = {0, 0, 0}, s[4] = {0, 0, 0, 0};
+    uint64_t col0 = 0;
+    odhs_stepper_strain(r.st, &r.g0);
+    odhs_stepper_counts(r.st, NULL, &col0, NULL);
+    const int per = (int)lround(w / 0.01);
+    for (int k = 0; k < per && !rc; ++k)
+        if (!(rc = hs_advance(&r, 0.01 * (k + 1), s)))
+            for (int a = 0; a < 3; ++a) acc[a] += s[a] / per;
+    for (int a = 0; a < 3; ++a) v[a] = acc[a];
+    v[3] = (s[3] - (double)col0) / w;
+    *cpu = bench_cpu() - c0;
+    odhs_stepper_counts(r.st, steps, NULL, NULL);
+    if (rc) fprintf(stderr, "batched --paired: %s failed: %s\n", pset[q].name, odhs_stepper_errmsg(r.st));
+    odhs_stepper_destroy(r.st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(sys);
+    return rc;
+}
+
+/* the summary of ok starts' window means val[start][setting][quantity]:
+ * per setting the mean, and the paired difference to the exact defaults' */
+static void paired_summary(double (*val)[NPSET][4], int ok)
+{
+    printf("# over %d starts: mean of each setting's window means, and its paired difference to the exact defaults' "
+           "(mean +- standard error over starts; sxy and p in %%)\n",
+           ok);
+    printf("%-20s %10s %18s %18s %20s %22s\n", "setting", "sxy", "dsxy_%", "dp_%", "dz", "dcoll/strain");
+    double *x = malloc((size_t)(ok > 1 ? ok : 1) * sizeof *x);
+    for (int q = 0; q < NPSET && ok >= 2 && x; ++q) {
+        double m[4], e[4], d[4], de[4];
+        for (int a = 0; a < 4; ++a) {
+            for (int k = 0; k < ok; ++k) x[k] = val[k][q][a];
+            pooled(x, ok, &m[a], &e[a]);
+            for (int k = 0; k < ok; ++k)
+                x[k] = a < 2 ? 100.0 * (val[k][q][a] / val[k][0][a] - 1.0) : val[k][q][a] - val[k][0][a];
+            pooled(x, ok, &d[a], &de[a]);
+        }
+        printf("%-20s %10.5f %8.3f+-%7.3f %8.3f+-%7.3f %9.5f+-%8.5f %10.1f+-%9.1f\n", pset[q].name, m[0], d[0], de[0],
+               d[1], de[1], d[2], de[2], d[3], de[3]);
+    }
+    free(x);
+}
+
+/* --pool-paired FILE...: the summary over the start rows of several --paired
+ * outputs (each file's starts are its own; a start needs every setting) */
+static int pool_paired(int nf, char **files)
+{
+    int cap = 0, ok = 0;
+    double (*val)[NPSET][4] = NULL;
+    for (int f = 0; f < nf; ++f) {
+        FILE *in = fopen(files[f], "r");
+        if (!in) {
+            perror(files[f]);
+            free(val);
+            return 1;
+        }
+        char line[512];
+        int cur = -1, seen = 0;
+        while (fgets(line, sizeof line, in)) {
+            int k, off = 0;
+            if (line[0] == '#' || sscanf(line, "%d %n", &k, &off) != 1) continue;
+            for (int q = 0; q < NPSET; ++q) {
+                size_t len = strlen(pset[q].name);
+                unsigned long long steps;
+                double cpu, v[4];
+                if (strncmp(line + off, pset[q].name, len) || (line[off + len] != ' ')) continue;
+                if (sscanf(line + off + len, "%llu %lf %lf %lf %lf %lf", &steps, &cpu, &v[0], &v[1], &v[2], &v[3]) != 6) {
+                    fprintf(stderr, "batched --pool-paired: %s: unreadable row: %s", files[f], line);
+                    fclose(in);
+                    free(val);
+                    return 1;
+                }
+                if (k != cur) { /* a new start */
+                    if (cur >= 0 && seen == (1 << NPSET) - 1) ++ok;
+                    cur = k;
+                    seen = 0;
+                    if (ok + 1 > cap) {
+                        void *nv = realloc(val, (size_t)(cap = 2 * cap + 8) * sizeof *val);
+                        if (!nv) {
+                            fclose(in);
+                            free(val);
+                            return 1;
+                        }
+                        val = nv;
+                    }
+                }
+                memcpy(val[ok][q], v, sizeof v);
+                seen |= 1 << q;
+            }
+        }
+        if (cur >= 0 && seen == (1 << NPSET) - 1) ++ok;
+        fclose(in);
+    }
+    printf("# pooled over the complete starts of %d file(s)\n", nf);
+    if (ok >= 2) paired_summary(val, ok);
+    free(val);
+    return ok < 2;
+}
+
+static int paired(int dim, size_t n, int starts, double w, double stride)
+{
+    const char *fs = getenv("ODHS_BENCH_FIRST_SEED");
+    const int seed = fs ? atoi(fs) : 0;
+    if (starts < 2 || starts > 64 || !(w >= 0.01) || !(stride > 0) || seed < 0) {
+        fprintf(stderr, "batched --paired: 2 <= STARTS <= 64, WINDOW >= 0.01, STRIDE > 0, ODHS_BENCH_FIRST_SEED >= 0\n");
+        return 2;
+    }
+    printf("# paired windows, %dD N = %zu, phi = %.2f, shear rate 1, solver auto; libodhs %s\n", dim, n,
+           dim == 2 ? 0.80 : 0.60, odhs_version_string());
+    printf("# seed %d: batched compression, warm-up to strain 1 (batched); %d starts %g apart on a batched carrier; "
+           "every setting over strain %g from each, sampled every 0.01\n",
+           seed, starts, stride, w);
+    printf("%5s %-20s %8s %8s %10s %9s %8s %12s\n", "start", "setting", "steps", "cpu_s", "sxy", "p", "z",
+           "coll/strain");
+    odhs_system *sys;
+    if (warmed_seed(dim, n, seed, &sys)) return 1;
+    odhs_solver *sol;
+    odhs_driver *drv;
+    odhs_stepper *carrier = shear_stepper(sys, S_BATCHED, &sol, &drv);
+    double (*val)[NPSET][4] = calloc((size_t)starts, sizeof *val);
+    int rc = !val || odhs_stepper_reset(carrier), ok = 0;
+    for (int k = 0; k < starts && !rc; ++k) {
+        double g;
+        odhs_stepper_strain(carrier, &g);
+        if ((rc = odhs_stepper_run_until_strain(carrier, g + stride)) || (rc = odhs_stepper_correct(carrier))) break;
+        for (int q = 0; q < NPSET && !rc; ++q) {
+            uint64_t steps = 0;
+            double cpu = 0;
+            rc = paired_window(sys, q, w, val[k][q], &steps, &cpu);
+            if (!rc)
+                printf("%5d %-20s %8llu %8.1f %10.5f %9.4f %8.4f %12.1f\n", k, pset[q].name, (unsigned long long)steps,
+                       cpu, val[k][q][0], val[k][q][1], val[k][q][2], val[k][q][3]);
+            fflush(stdout);
+        }
+        if (!rc) ok = k + 1;
+    }
+    if (rc && carrier) fprintf(stderr, "batched --paired: %s\n", odhs_stepper_errmsg(carrier));
+    paired_summary(val, ok);
+    free(val);
+    odhs_stepper_destroy(carrier);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(sol);
+    odhs_system_destroy(sys);
+    return rc != 0 || ok < 2;
+}
+
 /* ---- --rd0: the soft-core route at equal stress ------------------------------ */
 #define RD0_WARM 0.1 /* strain of RD0's own transient from the hard-sphere state */
 
@@ -918,7 +1108,11 @@ int main(int argc, char **argv)
     if (argc > 5 && !strcmp(argv[1], "--rd0"))
         return rd0(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]),
                    argc > 6 ? argv[6] : "1e-3,3e-4,1e-4,3e-5,1e-5");
+    if (argc > 5 && !strcmp(argv[1], "--paired"))
+        return paired(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]),
+                      argc > 6 ? atof(argv[6]) : 0.2);
     if (argc > 3 && !strcmp(argv[1], "--plot")) return plot_table(argv[2], argv[3]);
+    if (argc > 2 && !strcmp(argv[1], "--pool-paired")) return pool_paired(argc - 2, argv + 2);
     if (argc > 2 && !strcmp(argv[1], "--pool")) return pool_files(argc - 2, argv + 2);
     if (argc > 3 && !strcmp(argv[1], "--from")) return from_file(argv[2], atof(argv[3]), argc > 4 ? argv[4] : "batched");
     if (argc > 3 && !strcmp(argv[1], "--memory"))
