@@ -7,8 +7,10 @@
  * (solver auto), drift correction. Above NBUILD (default 16384) the start is
  * a periodic 2^d tiling of the packing of N / 2^d (repeated): the copies
  * start identical and part by round-off and chaos under shear.
- * Warm-up: shear at rate 1 to strain 0.3 with the batched integrator (not
- * timed). Then from that state, each setting in its own process (its peak
+ * Warm-up: shear at rate 1 to strain 0.3 (ODHS_BENCH_WARMUP: another) with
+ * the batched integrator (not timed); 0.3 leaves the packing in the
+ * transient from the compression, where the exact scheme costs about twice
+ * its steady-state figure at N = 4096: use 1 or more for steady-state costs. Then from that state, each setting in its own process (its peak
  * resident set size is its memory):
  *   exact      the library's defaults (adaptive Heun, tol 1e-6), solver auto,
  *              over the strain that holds EVENTS events (default 1000; from
@@ -32,8 +34,9 @@
  *          (ODHS_BENCH_FIRST_SEED=K: seeds K .. K+SEEDS-1, the trajectory
  *          only with seed 0; ODHS_BENCH_SKIP_TRAJECTORY=1 skips it;
  *          ODHS_BENCH_SETTINGS=exact,batched,tight or a subset)
- *        batched --from FILE.xyz STRAIN [exact|batched|tight]: one setting
- *          over STRAIN from a saved start: CPU time, steps, events, solves,
+ *        batched --from FILE STRAIN [exact|batched|tight]: one setting
+ *          over STRAIN from a saved start (FILE.xyz, or FILE.ckpt: the
+ *          system of a checkpoint): CPU time, steps, events, solves,
  *          drift-correction passes, factorisations (for profiles)
  *        batched --paired DIM N STARTS WINDOW [STRIDE]: from STARTS states
  *          of one batched run (STRIDE apart, default 0.2; seed
@@ -41,9 +44,13 @@
  *          the batched step at tol 1e-2 .. 1e-6 over the same window of
  *          strain WINDOW: the paired differences of the window means of
  *          sxy, p, z and collisions per unit strain (the batched bias of
- *          one stretch of trajectory, without the noise of separate runs)
+ *          one stretch of trajectory, without the noise of separate runs);
+ *          ODHS_BENCH_PAIRED_SETTINGS=1e-3,1e-4 (or heun, ...) runs only
+ *          those besides the exact defaults, ODHS_BENCH_PAIRED_SUB=L adds
+ *          the paired differences per sub-window of strain L
  *        batched --pool-paired FILE...: the same summary over the starts
- *          of several --paired outputs
+ *          of several --paired outputs (ODHS_BENCH_PAIRED_SETTINGS: the
+ *          settings a start must have)
  *        batched --pool FILE...: the pooled lines over the seed rows of
  *          several --accuracy outputs (seeds split across processes)
  *        batched --rd0 DIM N SEEDS STRAIN [RATES]: the same starts sheared
@@ -68,7 +75,13 @@
 #include "../examples/plot.h"
 
 enum { S_EXACT, S_BATCHED, S_TIGHT, S_COUNT };
-#define WARMUP 0.3 /* strain of the warm-up (batched) */
+/* strain of the scan's warm-up (batched): ODHS_BENCH_WARMUP, default 0.3.
+ * The exact setting's cost is measured right after it, over ~1000 events:
+ * after 0.3 the packing is still in the transient from the compression
+ * (stress ~25 % above the steady state at N = 4096, events per strain and
+ * cost per event higher), so its cost is high; 1 or more gives the
+ * steady-state cost (since 0.2.16). */
+static double warmup = 0.3;
 #define WINDOW 0.3 /* strain of a batched run */
 static const char *sname[S_COUNT] = {"exact (defaults)", "batched tol 1e-3", "batched tol 1e-4"};
 /* the tight setting's tolerance: ODHS_BENCH_TIGHT_TOL (default 1e-4), which
@@ -241,11 +254,11 @@ static void build_child(void *arg, void *out)
     odhs_driver *drv;
     odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
     b->rc = odhs_stepper_reset(st);
-    if (!b->rc) b->rc = odhs_stepper_run_until_strain(st, WARMUP);
+    if (!b->rc) b->rc = odhs_stepper_run_until_strain(st, warmup);
     if (!b->rc) b->rc = odhs_stepper_correct(st);
     uint64_t co = 0, op = 0;
     odhs_stepper_counts(st, NULL, &co, &op);
-    b->events_per_strain = (double)(co + op) / WARMUP;
+    b->events_per_strain = (double)(co + op) / warmup;
     b->nc = odhs_network_count(odhs_stepper_network(st));
     odhs_system_packing_fraction(sys, &b->phi);
     if (!b->rc) b->rc = odhs_checkpoint_write(st, j->path);
@@ -651,7 +664,23 @@ static int from_file(const char *path, double w, const char *setting)
     int s = !strcmp(setting, "exact") ? S_EXACT : !strcmp(setting, "tight") ? S_TIGHT : S_BATCHED;
     odhs_system *sys;
     char eb[256];
-    if (odhs_xyz_read(path, &sys, eb, sizeof eb)) {
+    size_t pl = strlen(path);
+    if (pl > 5 && !strcmp(path + pl - 5, ".ckpt")) { /* a checkpoint (the scan's start files): its system */
+        odhs_solver *cs;
+        odhs_driver *cd;
+        odhs_stepper *cst;
+        odhs_solver_create_by_name("auto", &cs);
+        int rc = odhs_checkpoint_read(path, cs, &sys, &cd, &cst, NULL, 0);
+        if (!rc) {
+            odhs_stepper_destroy(cst);
+            odhs_driver_destroy(cd);
+        }
+        odhs_solver_destroy(cs);
+        if (rc) {
+            fprintf(stderr, "batched --from: cannot read checkpoint %s (%d)\n", path, rc);
+            return 1;
+        }
+    } else if (odhs_xyz_read(path, &sys, eb, sizeof eb)) {
         fprintf(stderr, "batched --from: %s\n", eb);
         return 1;
     }
@@ -666,19 +695,24 @@ static int from_file(const char *path, double w, const char *setting)
     double cpu = bench_cpu() - c0 - cr, sxy = NAN, fact = 0, analyses = 0;
     uint64_t steps = 0, col = 0, op = 0, bsol = 0, corr = 0, passes = 0, closed = 0;
     odhs_stepper_counts(st, &steps, &col, &op);
-    odhs_stepper_batched_stats(st, NULL, NULL, &bsol);
+    uint64_t esteps = 0;
+    odhs_stepper_batched_stats(st, NULL, &esteps, &bsol);
     odhs_stepper_correction_stats(st, &corr, &passes, &closed);
     odhs_solver_get_stat(sol, "factorizations", &fact);
     odhs_solver_get_stat(sol, "analyses", &analyses);
+    double fb = NAN, rdef = NAN, fails = NAN;
+    odhs_solver_get_stat(sol, "fallbacks", &fails);
+    odhs_solver_get_stat(sol, "fallback_solves", &fb);
+    odhs_solver_get_stat(sol, "rank_deficient", &rdef);
     if (!rc) odhs_stepper_shear_stress(st, &sxy);
     printf("# libodhs %s, %s, N = %zu, strain %g from %s (status %d%s%s)\n", odhs_version_string(), sname[s],
            odhs_system_count(sys), w, path, rc, rc ? ": " : "", rc ? odhs_stepper_errmsg(st) : "");
-    printf("cpu_s %.2f reset_s %.2f steps %llu collisions %llu openings %llu contact_problem_solves %llu "
+    printf("cpu_s %.2f reset_s %.2f steps %llu exact_steps %llu collisions %llu openings %llu contact_problem_solves %llu "
            "corrections %llu correction_passes %llu correction_closed %llu factorizations %.0f analyses %.0f "
-           "sxy_end %.6f\n",
-           cpu, cr, (unsigned long long)steps, (unsigned long long)col, (unsigned long long)op,
+           "failed_attempts %.0f fallback_solves %.0f rank_deficient_solves %.0f sxy_end %.6f\n",
+           cpu, cr, (unsigned long long)steps, (unsigned long long)esteps, (unsigned long long)col, (unsigned long long)op,
            (unsigned long long)bsol, (unsigned long long)corr, (unsigned long long)passes, (unsigned long long)closed,
-           fact, analyses, sxy);
+           fact, analyses, fails, fb, rdef, sxy);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);
@@ -708,9 +742,37 @@ static const psetting pset[] = {
 };
 #define NPSET ((int)(sizeof pset / sizeof pset[0]))
 
+/* ODHS_BENCH_PAIRED_SETTINGS: a comma list of the settings to run besides
+ * the exact defaults, each a whole word of a setting's name ("heun" or a
+ * tolerance: "1e-3,1e-4"); default all. ODHS_BENCH_PAIRED_SUB=L: also the
+ * means over the sub-windows of strain L (W / L of them), to see whether a
+ * difference builds up along the window. */
+static int pwant[NPSET];
+static int psub_n;
+
+static void paired_options(double w)
+{
+    const char *e = getenv("ODHS_BENCH_PAIRED_SETTINGS");
+    for (int q = 0; q < NPSET; ++q) {
+        pwant[q] = 1;
+        if (q == 0 || !e || !*e) continue;
+        /* the token the list names this setting by: its last word, or "heun" */
+        const char *name = pset[q].integ == ODHS_INTEGRATOR_HEUN ? "heun" : strrchr(pset[q].name, ' ') + 1;
+        size_t l = strlen(name);
+        pwant[q] = 0;
+        for (const char *p = e; (p = strstr(p, name)) != NULL; p += l)
+            if ((p == e || p[-1] == ',') && (p[l] == '\0' || p[l] == ',')) pwant[q] = 1;
+    }
+    const char *sb = getenv("ODHS_BENCH_PAIRED_SUB");
+    double sub = sb ? atof(sb) : 0.0;
+    psub_n = sub >= 0.01 && sub < w ? (int)lround(w / sub) : 0;
+    if (psub_n > 100) psub_n = 100;
+}
+
 /* one window of strain w of setting q from start: window means of sxy, p, z
  * and collisions per unit strain into v; steps, cpu */
-static int paired_window(const odhs_system *start, int q, double w, double v[4], uint64_t *steps, double *cpu)
+static int paired_window(const odhs_system *start, int q, double w, double v[4], double *sub, uint64_t *steps,
+                         double *cpu)
 {
     odhs_system *sys;
     odhs_solver *sol;
@@ -725,9 +787,14 @@ static int paired_window(const odhs_system *start, int q, double w, double v[4],
     odhs_stepper_strain(r.st, &r.g0);
     odhs_stepper_counts(r.st, NULL, &col0, NULL);
     const int per = (int)lround(w / 0.01);
+    if (psub_n) memset(sub, 0, (size_t)psub_n * 3 * sizeof *sub);
     for (int k = 0; k < per && !rc; ++k)
         if (!(rc = hs_advance(&r, 0.01 * (k + 1), s)))
-            for (int a = 0; a < 3; ++a) acc[a] += s[a] / per;
+            for (int a = 0; a < 3; ++a) {
+                acc[a] += s[a] / per;
+                /* sample k in sub-window k * psub_n / per, each of per / psub_n samples */
+                if (psub_n) sub[(k * psub_n / per) * 3 + a] += s[a] * psub_n / per;
+            }
     for (int a = 0; a < 3; ++a) v[a] = acc[a];
     v[3] = (s[3] - (double)col0) / w;
     *cpu = bench_cpu() - c0;
@@ -750,6 +817,7 @@ static void paired_summary(double (*val)[NPSET][4], int ok)
     printf("%-20s %10s %18s %18s %20s %22s\n", "setting", "sxy", "dsxy_%", "dp_%", "dz", "dcoll/strain");
     double *x = malloc((size_t)(ok > 1 ? ok : 1) * sizeof *x);
     for (int q = 0; q < NPSET && ok >= 2 && x; ++q) {
+        if (!pwant[q]) continue;
         double m[4], e[4], d[4], de[4];
         for (int a = 0; a < 4; ++a) {
             for (int k = 0; k < ok; ++k) x[k] = val[k][q][a];
@@ -764,11 +832,43 @@ static void paired_summary(double (*val)[NPSET][4], int ok)
     free(x);
 }
 
+/* the paired differences per sub-window: does the bias build up along the
+ * window (a structural drift) or is it there from the start (the step's
+ * own)? subv[start][setting][sub][quantity] */
+static void paired_sub_summary(const double *subv, int ok, double w)
+{
+    printf("# per sub-window of strain %g: paired difference to the exact defaults (mean +- standard error over %d "
+           "starts; sxy in %%)\n",
+           w / psub_n, ok);
+    printf("%-20s %4s %8s %18s %20s\n", "setting", "sub", "strain", "dsxy_%", "dz");
+    double *x = malloc((size_t)ok * sizeof *x), *y = malloc((size_t)ok * sizeof *y);
+    for (int q = 1; q < NPSET && x && y; ++q) {
+        if (!pwant[q]) continue;
+        for (int j = 0; j < psub_n; ++j) {
+            double m, e, mz, ez;
+            for (int k = 0; k < ok; ++k) {
+                const double *a = subv + (((size_t)k * NPSET + (size_t)q) * (size_t)psub_n + (size_t)j) * 3;
+                const double *b = subv + (((size_t)k * NPSET) * (size_t)psub_n + (size_t)j) * 3;
+                x[k] = 100.0 * (a[0] / b[0] - 1.0);
+                y[k] = a[2] - b[2];
+            }
+            pooled(x, ok, &m, &e);
+            pooled(y, ok, &mz, &ez);
+            printf("%-20s %4d %8.3f %8.3f+-%7.3f %9.5f+-%8.5f\n", pset[q].name, j, w * (j + 0.5) / psub_n, m, e, mz,
+                   ez);
+        }
+    }
+    free(x);
+    free(y);
+}
+
 /* --pool-paired FILE...: the summary over the start rows of several --paired
  * outputs (each file's starts are its own; a start needs every setting) */
 static int pool_paired(int nf, char **files)
 {
-    int cap = 0, ok = 0;
+    int cap = 0, ok = 0, all = 0;
+    paired_options(1.0);
+    for (int q = 0; q < NPSET; ++q) all |= pwant[q] << q;
     double (*val)[NPSET][4] = NULL;
     for (int f = 0; f < nf; ++f) {
         FILE *in = fopen(files[f], "r");
@@ -794,7 +894,7 @@ static int pool_paired(int nf, char **files)
                     return 1;
                 }
                 if (k != cur) { /* a new start */
-                    if (cur >= 0 && seen == (1 << NPSET) - 1) ++ok;
+                    if (cur >= 0 && (seen & all) == all) ++ok;
                     cur = k;
                     seen = 0;
                     if (ok + 1 > cap) {
@@ -811,7 +911,7 @@ static int pool_paired(int nf, char **files)
                 seen |= 1 << q;
             }
         }
-        if (cur >= 0 && seen == (1 << NPSET) - 1) ++ok;
+        if (cur >= 0 && (seen & all) == all) ++ok;
         fclose(in);
     }
     printf("# pooled over the complete starts of %d file(s)\n", nf);
@@ -833,6 +933,10 @@ static int paired(int dim, size_t n, int starts, double w, double stride)
     printf("# seed %d: batched compression, warm-up to strain 1 (batched); %d starts %g apart on a batched carrier; "
            "every setting over strain %g from each, sampled every 0.01\n",
            seed, starts, stride, w);
+    paired_options(w);
+    if (psub_n)
+        printf("# sub-windows: %d of strain %g (rows '# sub START SETTING J sxy p z', summary at the end)\n", psub_n,
+               w / psub_n);
     printf("%5s %-20s %8s %8s %10s %9s %8s %12s\n", "start", "setting", "steps", "cpu_s", "sxy", "p", "z",
            "coll/strain");
     odhs_system *sys;
@@ -841,25 +945,33 @@ static int paired(int dim, size_t n, int starts, double w, double stride)
     odhs_driver *drv;
     odhs_stepper *carrier = shear_stepper(sys, S_BATCHED, &sol, &drv);
     double (*val)[NPSET][4] = calloc((size_t)starts, sizeof *val);
-    int rc = !val || odhs_stepper_reset(carrier), ok = 0;
+    /* sub-window means: [start][setting][sub][quantity] */
+    double *subv = calloc((size_t)starts * NPSET * (size_t)(psub_n ? psub_n : 1) * 3, sizeof *subv);
+    int rc = !val || !subv || odhs_stepper_reset(carrier), ok = 0;
     for (int k = 0; k < starts && !rc; ++k) {
         double g;
         odhs_stepper_strain(carrier, &g);
         if ((rc = odhs_stepper_run_until_strain(carrier, g + stride)) || (rc = odhs_stepper_correct(carrier))) break;
         for (int q = 0; q < NPSET && !rc; ++q) {
+            if (!pwant[q]) continue;
             uint64_t steps = 0;
-            double cpu = 0;
-            rc = paired_window(sys, q, w, val[k][q], &steps, &cpu);
+            double cpu = 0, *sub = subv + ((size_t)k * NPSET + (size_t)q) * (size_t)psub_n * 3;
+            rc = paired_window(sys, q, w, val[k][q], sub, &steps, &cpu);
             if (!rc)
                 printf("%5d %-20s %8llu %8.1f %10.5f %9.4f %8.4f %12.1f\n", k, pset[q].name, (unsigned long long)steps,
                        cpu, val[k][q][0], val[k][q][1], val[k][q][2], val[k][q][3]);
+            for (int j = 0; j < psub_n && !rc; ++j)
+                printf("# sub %d %-20s %d %10.5f %9.4f %8.4f\n", k, pset[q].name, j, sub[3 * j], sub[3 * j + 1],
+                       sub[3 * j + 2]);
             fflush(stdout);
         }
         if (!rc) ok = k + 1;
     }
     if (rc && carrier) fprintf(stderr, "batched --paired: %s\n", odhs_stepper_errmsg(carrier));
     paired_summary(val, ok);
+    if (psub_n && ok >= 2) paired_sub_summary(subv, ok, w);
     free(val);
+    free(subv);
     odhs_stepper_destroy(carrier);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);
@@ -1103,6 +1215,14 @@ int main(int argc, char **argv)
         snprintf(tight_name, sizeof tight_name, "batched tol %.0e", tight_tol);
         sname[S_TIGHT] = tight_name;
     }
+    const char *wu = getenv("ODHS_BENCH_WARMUP");
+    if (wu) {
+        warmup = atof(wu);
+        if (!(warmup >= 0.01 && warmup <= 100.0)) {
+            fprintf(stderr, "batched: ODHS_BENCH_WARMUP must be in [0.01, 100]\n");
+            return 2;
+        }
+    }
     if (argc > 5 && !strcmp(argv[1], "--accuracy"))
         return accuracy(atoi(argv[2]), (size_t)atol(argv[3]), atoi(argv[4]), atof(argv[5]));
     if (argc > 5 && !strcmp(argv[1], "--rd0"))
@@ -1143,8 +1263,8 @@ int main(int argc, char **argv)
            dim, dim == 2 ? 0.80 : 0.60);
     printf("# machine: %s (%ld logical CPUs); libodhs %s; load average at the start %.2f %.2f %.2f\n", cpu,
            sysconf(_SC_NPROCESSORS_ONLN), odhs_version_string(), la[0], la[1], la[2]);
-    printf("# start: batched compression (tiled above N = %zu), warm-up to strain 0.3 (batched); solver auto\n",
-           nbuild);
+    printf("# start: batched compression (tiled above N = %zu), warm-up to strain %g (batched); solver auto\n",
+           nbuild, warmup);
     printf("# exact: library defaults over %g events (from the warm-up's rate), skipped above N = %zu; batched: "
            "strain 0.3, its defaults (dt 5e-2); every setting in its own process\n",
            events, exact_nmax);

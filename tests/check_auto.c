@@ -492,9 +492,16 @@ static void check_hyperstatic(au_case *c, const char *what, size_t expect_nullit
     ck_assert_msg(c->nc - rank == expect_nullity || expect_nullity == SIZE_MAX, "%s: SVD nullity %zu", what,
                   c->nc - rank);
     ck_assert_msg(c->nc > rank, "%s: not hyperstatic", what);
-    /* configurations: default; without SuiteSparse; CG variant of lsq */
-    for (int cfg = 0; cfg < 3; ++cfg) {
+    /* configurations: default; without SuiteSparse; CG variant of lsq;
+     * (SuiteSparse builds) the preconditioned CG variant, lsq-pcg */
+#ifdef ODHS_HAVE_SUITESPARSE
+    const int ncfg = 4;
+#else
+    const int ncfg = 3;
+#endif
+    for (int cfg = 0; cfg < ncfg; ++cfg) {
         odhs_solver *a = au_solver("auto");
+        if (cfg == 3) CK_OK(odhs_solver_set_param(a, "lsq_dense_max", 0.0));
         if (cfg == 1 || cfg == 2) {
             int st = odhs_solver_set_param(a, "suitesparse", 0.0);
             ck_assert(st == ODHS_OK);
@@ -540,16 +547,42 @@ static void check_hyperstatic(au_case *c, const char *what, size_t expect_nullit
                     ck_assert_double_eq(au_stat(k, "fallbacks"), au_stat(a, "fallbacks") / 2.0);
                     odhs_solver_destroy(k);
                 }
-            } else {
+            } else if (cfg == 2) {
                 /* cg from zero on the consistent singular system: minimum
                  * norm already, no fallback needed */
                 ck_assert(!strcmp(name, "cg") || !strcmp(name, "lsq-cg"));
+            } else {
+                /* after cholmod-pcg and spqr fail: CG preconditioned by a
+                 * factor of N + beta I, from zero (minimum norm), in few
+                 * iterations; the rank is spqr's */
+                ck_assert_str_eq(name, "lsq-pcg");
+                ck_assert_msg(strstr(why, "spqr failed") && strstr(why, "-> lsq-pcg"), "why = \"%s\"", why);
+                double it = au_stat(a, "iterations");
+                ck_assert_msg(it >= 1.0 && it <= 30.0, "%s: lsq-pcg took %g iterations", what, it);
+                ck_assert_double_eq(au_stat(a, "rank"), (double)rank);
+                if (route == 0)
+                    fprintf(stderr, "[auto] %-28s lsq-pcg: %g iterations, forces vs dgelsd %.1e\n", what, it, e);
             }
             if (route == 0 && cfg == 0)
                 fprintf(stderr, "[auto] %-28s Nc=%3zu rank %zu: %s (forces vs dgelsd %.1e)\n", what, c->nc, rank,
                         why, e);
-            if (cfg < 2) ck_assert_double_eq(au_stat(a, "rank_deficient"), (double)(route + 1));
-            ck_assert_double_eq(au_stat(a, "fallback_solves"), cfg < 2 ? (double)(route + 1) : 0.0);
+            if (cfg != 2) ck_assert_double_eq(au_stat(a, "rank_deficient"), (double)(route + 1));
+            ck_assert_double_eq(au_stat(a, "fallback_solves"), cfg != 2 ? (double)(route + 1) : 0.0);
+        }
+        if (cfg == 3) {
+            /* an inconsistent system (b with a part in the null space of N:
+             * no solution): lsq-pcg stalls and gives up fast, and plain CG
+             * is not tried after it (it would stall too, after up to
+             * 10 Nc + 100 iterations) */
+            double *bi = xcalloc(c->nc, sizeof *bi);
+            au_vec(c->nc, bi, &rng);
+            memset(x, 0, c->nc * sizeof *x);
+            int st = odhs_solver_solve(a, c->net, bi, x);
+            ck_assert_msg(st == ODHS_E_NOCONV, "%s: inconsistent system gave %d", what, st);
+            const char *why;
+            au_backend(a, &why);
+            ck_assert_msg(strstr(why, "lsq-pcg failed") && !strstr(why, "lsq-cg"), "why = \"%s\"", why);
+            free(bi);
         }
         odhs_solver_destroy(a);
     }
@@ -604,6 +637,64 @@ START_TEST(test_hyperstatic_random)
 }
 END_TEST
 
+#ifdef ODHS_HAVE_SUITESPARSE
+extern const odhs_solver_type odhs__solver_type_lsq_pcg; /* internal: auto's lsq-pcg */
+#endif
+
+/* lsq-pcg on its own: a consistent singular system in a few iterations, to
+ * the minimum-norm solution; an inconsistent one (no solution) given up
+ * after 50 iterations without progress, not after maxiter; its parameters */
+START_TEST(test_lsq_pcg_direct)
+{
+#ifdef ODHS_HAVE_SUITESPARSE
+    au_case c = au_random(2, 40, 61, SIZE_MAX, 1.2);
+    tu_rng rng;
+    tu_rng_seed(&rng, 71);
+    double *g = xcalloc(c.nd, sizeof *g), *b = xcalloc(c.nc, sizeof *b), *x = xcalloc(c.nc, sizeof *x),
+           *xr = xcalloc(c.nc, sizeof *xr);
+    au_vec(c.nd, g, &rng);
+    CK_OK(odhs_network_apply_S(c.net, g, b));
+    size_t rank;
+    au_pinv_ref(&c, g, xr, &rank);
+    ck_assert(rank < c.nc);
+    odhs_solver *p;
+    CK_OK(odhs_solver_create(&odhs__solver_type_lsq_pcg, &p));
+    ck_assert_int_eq(odhs_solver_set_param(p, "shift", 0.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "shift", 1.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "no-such", 1.0), ODHS_E_INVALID);
+    CK_OK(odhs_solver_solve(p, c.net, b, x));
+    double it = au_stat(p, "iterations");
+    ck_assert_msg(it >= 1.0 && it <= 5.0, "consistent: %g iterations", it);
+    ck_assert_msg(au_reldiff(c.nc, x, xr) <= 1e-9, "consistent: %.3g from the minimum-norm forces",
+                  au_reldiff(c.nc, x, xr));
+    ck_assert_double_eq(au_stat(p, "factorizations"), 1.0);
+    /* a larger shift: more iterations, less round-off in the null space */
+    odhs_solver *p3;
+    CK_OK(odhs_solver_create(&odhs__solver_type_lsq_pcg, &p3));
+    CK_OK(odhs_solver_set_param(p3, "shift", 1e-3));
+    CK_OK(odhs_solver_solve(p3, c.net, b, x));
+    ck_assert_msg(au_reldiff(c.nc, x, xr) <= 1e-11, "shift 1e-3: %.3g", au_reldiff(c.nc, x, xr));
+    ck_assert_double_ge(au_stat(p3, "iterations"), it);
+    fprintf(stderr, "[auto] lsq-pcg direct Nc=%zu: %g iterations at shift 1e-6, %g at 1e-3\n", c.nc, it,
+            au_stat(p3, "iterations"));
+    odhs_solver_destroy(p3);
+    /* inconsistent: b with a part in the null space */
+    double *bi = xcalloc(c.nc, sizeof *bi);
+    au_vec(c.nc, bi, &rng);
+    ck_assert_int_eq(odhs_solver_solve(p, c.net, bi, x), ODHS_E_NOCONV);
+    double its = au_stat(p, "iterations");
+    ck_assert_msg(its >= 50.0 && its <= 80.0, "inconsistent: gave up after %g iterations (maxiter 500)", its);
+    odhs_solver_destroy(p);
+    free(bi);
+    free(g);
+    free(b);
+    free(x);
+    free(xr);
+    au_free(&c);
+#endif
+}
+END_TEST
+
 Suite *make_auto_suite(void)
 {
     Suite *s = suite_create("auto");
@@ -619,6 +710,7 @@ Suite *make_auto_suite(void)
     tcase_add_test(tc, test_hyperstatic_hex);
     tcase_add_test(tc, test_hyperstatic_square_lattice);
     tcase_add_test(tc, test_hyperstatic_random);
+    tcase_add_test(tc, test_lsq_pcg_direct);
     suite_add_tcase(s, tc);
     return s;
 }

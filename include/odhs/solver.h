@@ -122,7 +122,12 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
  *  Nc <= "lsq_dense_max", default 600; rank from SuiteSparseQR when it ran,
  *  else singular values above "lsq_rcond" (default 1e-9) times the largest,
  *  of S^T for odhs_solver_solve_ls and of N, with the threshold squared but
- *  at least 1e-13, for odhs_solver_solve) or "lsq-cg" (CG from zero). The
+ *  at least 1e-13, for odhs_solver_solve) or, above lsq_dense_max, "lsq-pcg"
+ *  (since 0.2.16, SuiteSparse builds: CG from zero preconditioned by a
+ *  CHOLMOD factor of N + beta I, beta = 1e-6 max diag N; a few iterations,
+ *  minimum norm to about 1e-10 relative; it gives up after 50 iterations
+ *  without halving the residual, the sign of an inconsistent system, and
+ *  lsq-cg is then not tried) and "lsq-cg" (CG from zero). The
  *  backend that answered after a fallback is tried first for the next
  *  "retry_after" solves (default 20); a least-squares backend only for
  *  the next "retry_after_lsq" solves (since 0.2.13; default 0: the primary is
@@ -135,7 +140,8 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
  *  gives ODHS_E_NOTINSTALLED). "tol" (since 0.2) is handed to the iterative
  *  backends cg and cholmod-pcg (their relative residual; default theirs,
  *  1e-12). Statistics: "backend" and "primary" (codes
- *  0 cg, 1 dense, 2 cholmod, 3 cholmod-pcg, 4 spqr, 5 lsq-svd, 6 lsq-cg; -1
+ *  0 cg, 1 dense, 2 cholmod, 3 cholmod-pcg, 4 spqr, 5 lsq-svd, 6 lsq-cg,
+ *  7 lsq-pcg (since 0.2.16); -1
  *  before the first solve), "fallbacks" (failed attempts followed by another
  *  backend), "fallback_solves" (solves not answered by the primary),
  *  "rank_deficient" (solves answered by lsq-*), "last_failure" (status of
@@ -171,7 +177,8 @@ ODHS_API const char *odhs_solver_name(const odhs_solver *s);
 /**
  * The backend that produced the last solution: for an "auto" handle the one
  * it chose or fell back to ("cg", "dense", "cholmod", "cholmod-pcg", "spqr",
- * "lsq-svd", "lsq-cg"; "auto" before its first solve), for any other handle
+ * "lsq-svd", "lsq-pcg" (since 0.2.16), "lsq-cg"; "auto" before its first
+ * solve), for any other handle
  * its own name. *why (why may be NULL) receives a description of the
  * fallbacks of the last solve ("cholmod-pcg failed (...) -> spqr"), "" when
  * there was none; after a failed solve it lists every attempt. Both strings

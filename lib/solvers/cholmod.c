@@ -41,7 +41,7 @@ typedef struct {
     cholmod_common c;
     cholmod_sparse *A;        /* S, Nc x Nd */
     cholmod_factor *L;        /* factor of S S^T */
-    cholmod_dense *B, *X, *Y, *E; /* right-hand side, solution, workspace */
+    cholmod_dense *work[4]; /* cholmod_solve2: B (right-hand side), X (solution), Y, E */
     size_t *pci, *pcj;        /* contact list of the current analysis */
     size_t pnc, pcicap, pcjcap, pn;
     int pdim;
@@ -69,13 +69,7 @@ static void chm_destroy(void *state)
 {
     chm_state *s = state;
     if (!s) return;
-    cholmod_free_factor(&s->L, &s->c);
-    cholmod_free_sparse(&s->A, &s->c);
-    cholmod_free_dense(&s->B, &s->c);
-    cholmod_free_dense(&s->X, &s->c);
-    cholmod_free_dense(&s->Y, &s->c);
-    cholmod_free_dense(&s->E, &s->c);
-    cholmod_finish(&s->c);
+    odhs__cm_release(&s->c, &s->L, &s->A, s->work);
     odhs__free(s->pci);
     odhs__free(s->pcj);
     odhs__free(s->cnt);
@@ -165,13 +159,7 @@ static int chm_solve(void *state, const odhs_network *net, const double *b, doub
     chm_state *s = state;
     size_t nc = net->nc;
     if (!s->factored || !s->L || s->L->n != nc) return ODHS_E_STATE;
-    int st = odhs__cm_ensure_dense(&s->B, nc, &s->c);
-    if (st) return st;
-    memcpy(s->B->x, b, nc * sizeof *b);
-    if (!cholmod_solve2(CHOLMOD_A, s->L, s->B, NULL, &s->X, NULL, &s->Y, &s->E, &s->c))
-        return odhs__cm_error(&s->c);
-    memcpy(x, s->X->x, nc * sizeof *x);
-    return ODHS_OK;
+    return odhs__cm_solve(&s->c, s->L, s->work, nc, b, x);
 }
 
 ODHS_API const odhs_solver_type odhs_solver_type_cholmod = {

@@ -27,6 +27,24 @@ void odhs__cm_start(cholmod_common *c)
     c->error_handler = NULL;
 }
 
+int odhs__cm_solve(cholmod_common *c, cholmod_factor *L, cholmod_dense *work[4], size_t n, const double *b, double *x)
+{
+    int st = odhs__cm_ensure_dense(&work[0], n, c);
+    if (st) return st;
+    memcpy(work[0]->x, b, n * sizeof *b);
+    if (!cholmod_solve2(CHOLMOD_A, L, work[0], NULL, &work[1], NULL, &work[2], &work[3], c)) return odhs__cm_error(c);
+    memcpy(x, work[1]->x, n * sizeof *x);
+    return ODHS_OK;
+}
+
+void odhs__cm_release(cholmod_common *c, cholmod_factor **L, cholmod_sparse **A, cholmod_dense *work[4])
+{
+    cholmod_free_factor(L, c);
+    cholmod_free_sparse(A, c);
+    for (int k = 0; k < 4; ++k) cholmod_free_dense(&work[k], c);
+    cholmod_finish(c);
+}
+
 /* Whether the network's sizes fit CHOLMOD's int interface for a matrix
  * [S | E] with nextra extra unit columns. */
 int odhs__cm_fits_int(const odhs_network *net, size_t nextra)

@@ -26,6 +26,12 @@
 int odhs__cm_error(const cholmod_common *c);
 /* cholmod_start with printing and the error handler off */
 void odhs__cm_start(cholmod_common *c);
+/* x = A^-1 b (n entries) with the factor L of A, through cholmod_solve2 and
+ * its dense work (B, X, Y, E: kept between calls). */
+int odhs__cm_solve(cholmod_common *c, cholmod_factor *L, cholmod_dense *work[4], size_t n, const double *b, double *x);
+/* Free a backend's factor *L, matrix *A and cholmod_solve2's dense work
+ * (B, X, Y, E), then cholmod_finish(c). */
+void odhs__cm_release(cholmod_common *c, cholmod_factor **L, cholmod_sparse **A, cholmod_dense *work[4]);
 /* Whether the network's sizes fit CHOLMOD's int interface for a matrix
  * [S | E] with nextra extra unit columns. */
 int odhs__cm_fits_int(const odhs_network *net, size_t nextra);

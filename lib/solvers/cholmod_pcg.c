@@ -80,7 +80,7 @@ typedef struct {
     cholmod_sparse *A;        /* [S | E] of the last full factorisation */
     cholmod_factor *L;        /* simplicial LDL' of the slot matrix M */
     cholmod_sparse *R;        /* cap x 1: new row for rowadd */
-    cholmod_dense *B, *X, *Y, *E;
+    cholmod_dense *work[4]; /* cholmod_solve2: B (right-hand side), X (solution), Y, E */
     size_t cap;               /* slots = dimension of L */
     size_t *si, *sj;          /* pair held by each slot, NO_SLOT if free */
     size_t *freel, nfree;     /* stack of free slots */
@@ -136,14 +136,8 @@ static void pcg_destroy(void *state)
 {
     pcg_state *s = state;
     if (!s) return;
-    cholmod_free_factor(&s->L, &s->c);
-    cholmod_free_sparse(&s->A, &s->c);
+    odhs__cm_release(&s->c, &s->L, &s->A, s->work);
     cholmod_free_sparse(&s->R, &s->c);
-    cholmod_free_dense(&s->B, &s->c);
-    cholmod_free_dense(&s->X, &s->c);
-    cholmod_free_dense(&s->Y, &s->c);
-    cholmod_free_dense(&s->E, &s->c);
-    cholmod_finish(&s->c);
     odhs__free(s->si);
     odhs__free(s->sj);
     odhs__free(s->freel);
@@ -510,13 +504,13 @@ static int pcg_setup(void *state, const odhs_network *net)
 static int pcg_precond(pcg_state *s, size_t nc, const double *r, double *z)
 {
     /* a refactorisation inside the solve may have grown the slot capacity */
-    int st = odhs__cm_ensure_dense(&s->B, s->cap, &s->c);
+    int st = odhs__cm_ensure_dense(&s->work[0], s->cap, &s->c);
     if (st) return st;
-    double *bx = s->B->x;
+    double *bx = s->work[0]->x;
     memset(bx, 0, s->cap * sizeof *bx);
     for (size_t c = 0; c < nc; ++c) bx[s->c2s[c]] = r[c];
-    if (!cholmod_solve2(CHOLMOD_A, s->L, s->B, NULL, &s->X, NULL, &s->Y, &s->E, &s->c)) return odhs__cm_error(&s->c);
-    const double *xx = s->X->x;
+    if (!cholmod_solve2(CHOLMOD_A, s->L, s->work[0], NULL, &s->work[1], NULL, &s->work[2], &s->work[3], &s->c)) return odhs__cm_error(&s->c);
+    const double *xx = s->work[1]->x;
     for (size_t c = 0; c < nc; ++c) z[c] = xx[s->c2s[c]];
     return ODHS_OK;
 }
@@ -592,7 +586,7 @@ static int pcg_solve(void *state, const odhs_network *net, const double *b, doub
     s->iterations = 0.0;
     if (!s->valid || !s->L || s->nc != nc) return ODHS_E_STATE;
     if ((st = odhs__reserve((void **)&s->w, &s->wcap, 4 * nc + nd, sizeof *s->w))) return st;
-    if ((st = odhs__cm_ensure_dense(&s->B, s->cap, &s->c))) return st;
+    if ((st = odhs__cm_ensure_dense(&s->work[0], s->cap, &s->c))) return st;
     double bn = 0.0;
     for (size_t c = 0; c < nc; ++c) bn += b[c] * b[c];
     bn = sqrt(bn);

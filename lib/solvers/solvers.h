@@ -48,4 +48,11 @@ void odhs__solver_invalidate(odhs_solver *s);
 int odhs__solver_push_param(odhs_solver *s, const char *key, double v, double *old);
 void odhs__solver_pop_param(odhs_solver *s, const char *key, int pushed, double old);
 
+#ifdef ODHS_HAVE_SUITESPARSE
+/* "lsq-pcg" (lsq_pcg.c): minimum-norm solutions of singular N x = b by CG
+ * preconditioned with a factor of N + beta I; the auto solver's
+ * least-squares route above lsq_dense_max contacts (since 0.2.16) */
+extern const odhs_solver_type odhs__solver_type_lsq_pcg;
+#endif
+
 #endif /* ODHS_SOLVERS_SOLVERS_H */

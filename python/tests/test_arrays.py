@@ -191,7 +191,7 @@ def test_step_ex_and_the_remaining_getters(run):
     assert st2.driver.time_unit(st2.system) == 0.5
     st2.driver.clear_time_unit()
     assert st2.errors.contact_gap < 1e-6
-    assert st2.solver.last_backend[0] in {i.name for i in odhs.available_solvers()} | {"lsq-svd", "lsq-cg"}
+    assert st2.solver.last_backend[0] in {i.name for i in odhs.available_solvers()} | {"lsq-svd", "lsq-pcg", "lsq-cg"}
     st2.solver.set_check_tolerance(1e-6)
     st2.solver.set_refinement(2)
     net = odhs.Network(s)
