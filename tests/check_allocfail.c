@@ -1087,6 +1087,65 @@ static void files_capture(const af_fix *f, const af_scenario *sc, int op, af_buf
 
 static void files_final(af_fix *f, const af_scenario *sc) { check_network(f->net, sc->name); }
 
+/* -- lsq: auto's least-squares routes on a hyperstatic network (a periodic
+ * 4 x 4 square lattice: 32 contacts, rank 24) with lsq_dense_max = 0, so
+ * that SuiteSparse builds answer with lsq-pcg (lsq-cg absorbs its
+ * failures), twice: its first setup and a solve on the kept handle -------- */
+static void lsq_setup(af_fix *f, const af_scenario *sc)
+{
+    (void)sc;
+    double L[2] = {4.0, 4.0}, r[16], x[32];
+    for (int i = 0; i < 16; ++i) {
+        r[i] = 0.5;
+        x[2 * i] = 0.5 + (i % 4);
+        x[2 * i + 1] = 0.5 + (i / 4);
+    }
+    AF_OK(odhs_system_create(2, 16, &f->sys));
+    AF_OK(odhs_system_set_configuration(f->sys, L, 0.0, r, x));
+    AF_OK(odhs_network_create(f->sys, &f->net));
+    AF_OK(odhs_network_detect(f->net, f->sys, 1e-9));
+    f->nc = odhs_network_count(f->net);
+    AF_ASSERT(f->nc == 32);
+    AF_OK(odhs_solver_create_by_name("auto", &f->sol));
+    AF_OK(odhs_solver_set_param(f->sol, "lsq_dense_max", 0.0));
+    f->g = malloc(32 * sizeof *f->g);
+    f->b = malloc(f->nc * sizeof *f->b);
+    f->x1 = calloc(f->nc, sizeof *f->x1);
+    AF_ASSERT(f->g && f->b && f->x1);
+    for (int k = 0; k < 32; ++k) f->g[k] = sin(1.0 + 0.7 * k); /* generic: not in a symmetry subspace */
+    AF_OK(odhs_network_apply_S(f->net, f->g, f->b));
+}
+
+static int lsq_op(af_fix *f, const af_scenario *sc, int k)
+{
+    (void)sc;
+    memset(f->x1, 0, f->nc * sizeof *f->x1);
+    return k == 0 ? odhs_solver_solve(f->sol, f->net, f->b, f->x1) : odhs_solver_solve_ls(f->sol, f->net, f->g, f->x1);
+}
+
+static void lsq_capture(const af_fix *f, const af_scenario *sc, int op, af_buf *b)
+{
+    (void)sc;
+    (void)op;
+    rec_system(b, "sys", f->sys);
+    rec_network(b, "net", f->net);
+}
+
+static void lsq_final(af_fix *f, const af_scenario *sc)
+{
+    /* the answer: a least-squares solution (S (S^T x - g) = 0 to 1e-8) */
+    double *sx = malloc(32 * sizeof *sx), *res = malloc(f->nc * sizeof *res);
+    AF_ASSERT(sx && res);
+    AF_OK(odhs_network_apply_ST(f->net, f->x1, sx));
+    for (int k = 0; k < 32; ++k) sx[k] -= f->g[k];
+    AF_OK(odhs_network_apply_S(f->net, sx, res));
+    double rn = 0.0;
+    for (size_t c = 0; c < f->nc; ++c) rn += res[c] * res[c];
+    AF_MSG(sqrt(rn) < 1e-8, "%s: |S (S^T x - g)| = %.3g", sc->name, sqrt(rn));
+    free(sx);
+    free(res);
+}
+
 /* -- outputs: contacts CSV, LAMMPS data file written and read, a trajectory
  * of two frames with velocities, read back ----------------------------------- */
 static void outputs_setup(af_fix *f, const af_scenario *sc)
@@ -1512,6 +1571,7 @@ static const af_scenario scenarios[] = {
     {"jam_lp", 7, 0, jam_lp_setup, NULL, jam_lp_op, jam_lp_capture, jam_lp_final},
     {"jam_quench", 7, 1, jam_lp_setup, NULL, jam_lp_op, jam_lp_capture, jam_lp_final},
 #endif
+    {"lsq", 2, 0, lsq_setup, NULL, lsq_op, lsq_capture, lsq_final},
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"analysis", 6, 0, analysis_setup, NULL, analysis_op, analysis_capture, files_final},
     {"outputs", 8, 0, outputs_setup, NULL, outputs_op, outputs_capture, outputs_final},
