@@ -316,8 +316,7 @@ static int attempt(auto_state *s, int b, const odhs_network *net, const double *
             if (st) return st;
             odhs_solver_set_check_tolerance(s->lsqpcg, s->check_tol);
         }
-        h = s->lsqpcg;
-        memset(x, 0, nc * sizeof *x); /* it starts from zero itself; the guess is unused */
+        h = s->lsqpcg; /* starts from zero itself: the minimum-norm solution */
 #else
         return ODHS_E_NOTINSTALLED;
 #endif

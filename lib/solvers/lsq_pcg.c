@@ -172,7 +172,7 @@ static int lp_solve(void *state, const odhs_network *net, const double *b, doubl
         odhs__net_N(net, p, q, tmp);
         double pq = 0.0;
         for (size_t c = 0; c < nc; ++c) pq += p[c] * q[c];
-        if (!(pq > 0.0)) break; /* a breakdown: judged on the true residual below */
+        if (!(pq > 0.0)) break; /* a breakdown: judged on the true residual too */
         double alpha = rz / pq, rn = 0.0;
         for (size_t c = 0; c < nc; ++c) {
             x[c] += alpha * p[c];
@@ -190,16 +190,7 @@ static int lp_solve(void *state, const odhs_network *net, const double *b, doubl
             s->iterations = (double)it;
             return ODHS_E_NOCONV;
         }
-        if (sqrt(rn) <= target) {
-            /* confirm on the true residual */
-            odhs__net_N(net, x, q, tmp);
-            rn = 0.0;
-            for (size_t c = 0; c < nc; ++c) {
-                r[c] = b[c] - q[c];
-                rn += r[c] * r[c];
-            }
-            if (sqrt(rn) <= target) break;
-        }
+        if (sqrt(rn) <= target) break; /* confirmed on the true residual below */
         if ((st = lp_precond(s, r, z))) return st;
         double rz_new = 0.0;
         for (size_t c = 0; c < nc; ++c) rz_new += r[c] * z[c];
