@@ -5,14 +5,15 @@
  * strain; and the paper's Fig. 7 signals (shear stress, phi, kappa against
  * strain) at p = 10.
  *
- *   build/bench/rheology [DIM] [N] [SEEDS] [STRAIN] [PMAX] [TRANSIENT] [PMIN] [euler|heun]
+ *   build/bench/rheology [DIM] [N] [SEEDS] [STRAIN] [PMAX] [TRANSIENT] [PMIN] [euler|heun|batched[:TOL]]
  *       defaults 2 256 2 1.0 1e4 0.3 10 euler
  *
  * Each seed: the bidisperse scene of the examples (50:50, size ratio 1.4,
  * 3 % polydisperse), random at low density, compressed to phi = 0.80 (2D) or
  * 0.60 (3D), then sheared at p = PMIN, 10 PMIN, ... up to PMAX with the paper's
  * scheme (Euler, dt = 1e-3, drift correction every 10 steps; or the adaptive
- * scheme, tolerance 1e-6, correction every step) and the auto solver. The first TRANSIENT of strain is discarded; mu and phi are sampled
+ * scheme, tolerance 1e-6, correction every step; or the batched-event scheme
+ * at its default tolerance 1e-3 or at TOL) and the auto solver. The first TRANSIENT of strain is discarded; mu and phi are sampled
  * every 0.01 of strain and averaged in blocks of 0.1 strain: the error bar is
  * the standard error of the block means (all seeds pooled). Events and CPU
  * time are per unit strain of the steady part.
@@ -62,6 +63,20 @@ typedef struct {
 } run;
 
 static int integrator = ODHS_INTEGRATOR_EULER;
+static double batched_tol; /* batched:TOL (0: the integrator's default) */
+
+/* the scheme's name in files and headers */
+static const char *scheme_name(void)
+{
+    static char name[48]; /* main thread only */
+    if (integrator == ODHS_INTEGRATOR_HEUN) return "heun";
+    if (integrator != ODHS_INTEGRATOR_BATCHED) return "euler";
+    if (batched_tol > 0.0)
+        snprintf(name, sizeof name, "batched%g", batched_tol);
+    else
+        snprintf(name, sizeof name, "batched");
+    return name;
+}
 static int first_seed; /* ODHS_BENCH_FIRST_SEED */
 
 static run start(int dim, size_t n, unsigned seed, double p)
@@ -75,6 +90,7 @@ static run start(int dim, size_t n, unsigned seed, double p)
     CHECK(odhs_driver_set_compression_rate(r.drv, 1.0));
     CHECK(odhs_stepper_create(r.sys, r.drv, r.sol, &r.st));
     CHECK(odhs_stepper_set_integrator(r.st, integrator));
+    if (integrator == ODHS_INTEGRATOR_BATCHED && batched_tol > 0.0) CHECK(odhs_stepper_set_tolerance(r.st, batched_tol));
     CHECK(odhs_stepper_run_until_packing_fraction(r.st, dim == 2 ? 0.80 : 0.60));
     CHECK(odhs_driver_set_compression_rate(r.drv, 0.0));
     CHECK(odhs_driver_set_shear_rate(r.drv, 1.0));
@@ -131,7 +147,7 @@ static void state_paths(char *ck, char *acc, size_t len, int dim, size_t n, doub
                         double transient)
 {
     snprintf(ck, len, "%s/rheology_%dd_n%zu_p%g_seed%u_tr%g_%s.ckpt", state_dir, dim, n, p, seed, transient,
-             integrator == ODHS_INTEGRATOR_HEUN ? "heun" : "euler");
+             scheme_name());
     snprintf(acc, len, "%.*s.acc", (int)(strlen(ck) - 5), ck);
 }
 
@@ -324,18 +340,32 @@ int main(int argc, char **argv)
     first_seed = fs ? atoi(fs) : 0;
     state_dir = getenv("ODHS_BENCH_STATE_DIR");
     if (state_dir && !*state_dir) state_dir = NULL;
-    if (argc > 8) integrator = !strcmp(argv[8], "heun") ? ODHS_INTEGRATOR_HEUN : !strcmp(argv[8], "euler") ? 0 : -1;
+    if (argc > 8) {
+        integrator = !strcmp(argv[8], "heun") ? ODHS_INTEGRATOR_HEUN : !strcmp(argv[8], "euler") ? 0 : -1;
+        if (!strncmp(argv[8], "batched", 7)) {
+            integrator = ODHS_INTEGRATOR_BATCHED;
+            if (argv[8][7] == ':') {
+                char *end;
+                batched_tol = strtod(argv[8] + 8, &end);
+                if (*end || !(batched_tol > 0.0 && batched_tol < 1.0)) integrator = -1;
+            } else if (argv[8][7]) {
+                integrator = -1;
+            }
+        }
+    }
     if ((dim != 2 && dim != 3) || n < 8 || seeds < 1 || !(strain > transient) || !(pmin > 0.0) || !(pmax >= pmin) ||
         integrator < 0 || first_seed < 0 || first_seed > 1000) {
-        fprintf(stderr, "usage: rheology [DIM] [N] [SEEDS] [STRAIN] [PMAX] [TRANSIENT] [PMIN] [euler|heun]\n");
+        fprintf(stderr, "usage: rheology [DIM] [N] [SEEDS] [STRAIN] [PMAX] [TRANSIENT] [PMIN] [euler|heun|batched[:TOL]]\n");
         return 2;
     }
-    char cpu[128], tag[64];
+    char cpu[128], tag[96];
     int ncpu = bench_cpu_model(cpu, sizeof cpu);
-    snprintf(tag, sizeof tag, "%dd_n%zu%s", dim, n, integrator == ODHS_INTEGRATOR_HEUN ? "_heun" : "");
+    snprintf(tag, sizeof tag, "%dd_n%zu%s%s", dim, n, integrator == ODHS_INTEGRATOR_EULER ? "" : "_", integrator == ODHS_INTEGRATOR_EULER ? "" : scheme_name());
     printf("# rheology: %dD N = %zu, %d seed(s) from seed %d, strain %.2f (first %.2f discarded), %s, auto solver\n",
            dim, n, seeds, 11 + 7 * first_seed, strain, transient,
-           integrator == ODHS_INTEGRATOR_HEUN ? "adaptive Heun tol 1e-6" : "Euler dt = 1e-3");
+           integrator == ODHS_INTEGRATOR_HEUN      ? "adaptive Heun tol 1e-6"
+           : integrator == ODHS_INTEGRATOR_BATCHED ? (batched_tol > 0.0 ? "batched events at the set tolerance" : "batched events, default tolerance 1e-3")
+                                                   : "Euler dt = 1e-3");
     printf("# machine: %s (%d CPUs listed), libodhs %s, OPENBLAS_NUM_THREADS=%s\n", cpu, ncpu, odhs_version_string(),
            getenv("OPENBLAS_NUM_THREADS") ? getenv("OPENBLAS_NUM_THREADS") : "unset");
     printf("# mu = sigma_xy/p, I_v = xi0 gdot/p; +- the standard error of block means (0.1 strain)\n");

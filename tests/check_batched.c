@@ -288,10 +288,16 @@ static void invariants_case(int dim, double p)
             dim, p, w.steps, (unsigned long long)nb, (unsigned long long)ne, (unsigned long long)coll, w.overlap,
             w.gap, w.negative, w.power);
     ck_assert_msg(nb > ne, "batched %llu, exact %llu", (unsigned long long)nb, (unsigned long long)ne);
-    ck_assert_msg(coll > w.steps, "%llu collisions in %zu steps: no batching", (unsigned long long)coll, w.steps);
+    /* at p = 1000 the steps are short (the error controller follows the
+     * relaxation time 1/p of the nearly isostatic network) and 40 % fall
+     * back to exact ones: batching is measured there, not asserted */
+    if (p < 1000)
+        ck_assert_msg(coll > w.steps, "%llu collisions in %zu steps: no batching", (unsigned long long)coll, w.steps);
     ck_assert_msg(w.overlap <= 1e-12, "overlap %g", w.overlap);
     ck_assert_msg(w.negative <= 1e-12, "negative force %g", w.negative);
-    ck_assert_msg(w.power <= 1e-10, "power balance %g", w.power);
+    /* near isostatic the forces carry the conditioning of N (as the exact
+     * scheme's in check_rheology: 1e-7 there) */
+    ck_assert_msg(w.power <= (p < 1000 ? 1e-10 : 1e-8), "power balance %g", w.power);
     if (p == 0) ck_assert_msg(w.gap <= 1e-12, "contact gap %g", w.gap);
     bscene_free(&s);
     odhs_system_destroy(start);
@@ -304,6 +310,18 @@ START_TEST(test_invariants_3d) { invariants_case(3, 0.0); }
 END_TEST
 
 START_TEST(test_invariants_pressure_2d) { invariants_case(2, 10.0); }
+END_TEST
+
+/* high pressure (I_v = 1e-3), where the flowing network is nearly
+ * isostatic: before 0.2.17 the drift correction after a batched step moved
+ * particles by up to 2500 times the step's gaps at fixed volume and its
+ * chord closed dozens of pairs at once, and the run stopped on a network
+ * whose self-stresses the rewiring could not order (2D N = 256, p = 1000:
+ * six seeds of six within strain 0.08) */
+START_TEST(test_invariants_pressure_high_2d) { invariants_case(2, 1000.0); }
+END_TEST
+
+START_TEST(test_invariants_pressure_high_3d) { invariants_case(3, 1000.0); }
 END_TEST
 
 /* rigid dimers made of touching pairs in a sheared packing: the bonds
@@ -772,6 +790,8 @@ Suite *make_batched_suite(void)
     tcase_add_test(tc, test_invariants_2d);
     tcase_add_test(tc, test_invariants_3d);
     tcase_add_test(tc, test_invariants_pressure_2d);
+    tcase_add_test(tc, test_invariants_pressure_high_2d);
+    tcase_add_test(tc, test_invariants_pressure_high_3d);
     tcase_add_test(tc, test_invariants_dimers);
     tcase_add_test(tc, test_invariants_piston);
     tcase_add_test(tc, test_events_replay_network);

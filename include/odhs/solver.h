@@ -122,7 +122,9 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
  *  Nc <= "lsq_dense_max", default 600; rank from SuiteSparseQR when it ran,
  *  else singular values above "lsq_rcond" (default 1e-9) times the largest,
  *  of S^T for odhs_solver_solve_ls and of N, with the threshold squared but
- *  at least 1e-13, for odhs_solver_solve) or, above lsq_dense_max, "lsq-pcg"
+ *  at least 1e-13, for odhs_solver_solve; on N since 0.2.17 from its
+ *  eigendecomposition, LAPACK dsyevd, a fifth of the SVD's cost, the SVD
+ *  if that fails) or, above lsq_dense_max, "lsq-pcg"
  *  (since 0.2.16, SuiteSparse builds: CG from zero preconditioned by a
  *  CHOLMOD factor of N + beta I, beta = 1e-6 max diag N; a few iterations,
  *  minimum norm to about 1e-10 relative; it gives up after 50 iterations
