@@ -278,7 +278,8 @@ static void invariants_case(int dim, double p)
     bscene s;
     worst w;
     sheared(&s, start, 1.0, p, ODHS_INTEGRATOR_BATCHED, 0, 0);
-    run_checked(s.st, 0.1, &w);
+    /* at p = 1000 strain 0.04 (0.2.16 stopped at 0.020 in 2D, 0.0075 in 3D) */
+    run_checked(s.st, p >= 1000 ? 0.04 : 0.1, &w);
     uint64_t nb, ne, coll;
     ck_assert_int_eq(odhs_stepper_batched_stats(s.st, &nb, &ne, NULL), ODHS_OK);
     ck_assert_int_eq(odhs_stepper_counts(s.st, NULL, &coll, NULL), ODHS_OK);
