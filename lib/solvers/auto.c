@@ -278,6 +278,9 @@ static int pinv_sym_solve(auto_state *s, double *A, size_t n, const double *y, d
     if (r >= 0) rank = (size_t)r < n ? (size_t)r : n;
     else
         while (rank < n && s->sv[n - 1 - rank] > rc * lmax) rank++;
+    /* a rank from outside (SuiteSparseQR's) never takes in a round-off
+     * eigenvalue at or below zero */
+    while (rank > 0 && !(s->sv[n - rank] > 0.0)) rank--;
     for (size_t q = n - rank; q < n; ++q) {
         double c = 0.0;
         const double *v = A + q * n;
