@@ -42,6 +42,25 @@ static int subset_contacts(const odhs_network *net, size_t **idx, size_t *m)
  * accuracy at eps sigma_max / sigma_2 instead of its square. The kernel must
  * be one-dimensional: the next singular value clearly > 0 (columns of S^T
  * have norm sqrt 2, so singular values are O(1) scaled). */
+/* S^T on the contacts idx[0..m-1] (and the row r^T when rv is given) into
+ * the R x m column-major A, rows of particle i at row[i] * d: column a =
+ * s_a^T, -n on i's rows, +n on j's (a wall has no block) */
+static void fill_ST(const odhs_network *net, const size_t *idx, size_t m, const double *rv, const size_t *row,
+                    size_t R, double *A)
+{
+    int d = net->dim;
+    memset(A, 0, R * m * sizeof *A);
+    for (size_t a = 0; a < m; ++a) {
+        size_t c = idx[a];
+        const double *nc = net->nrm + c * d;
+        for (int k = 0; k < d; ++k) {
+            A[a * R + row[net->ci[c]] * d + k] = -nc[k];
+            if (net->cj[c] < net->n) A[a * R + row[net->cj[c]] * d + k] = nc[k];
+        }
+        if (rv) A[a * R + R - 1] = rv[a];
+    }
+}
+
 static int null_dense(const odhs_network *net, const size_t *idx, size_t m, const double *rv, double *y)
 {
     int d = net->dim;
@@ -55,28 +74,17 @@ static int null_dense(const odhs_network *net, const size_t *idx, size_t m, cons
         if (net->cj[c] < n && row[net->cj[c]] == SIZE_MAX) row[net->cj[c]] = nr++;
     }
     size_t R = nr * (size_t)d + (rv ? 1 : 0), ns = R < m ? R : m;
-    double *A = odhs__calloc(R * m + 1, sizeof *A);
+    double *A = odhs__malloc_array(R * m + 1, sizeof *A);
     /* dgesdd (below) for small subsets only: its workspace grows as m^2 */
     const int dc = m <= DENSE_MAX;
-    double *A2 = odhs__malloc_array(dc ? R * m + 1 : 1, sizeof *A2);
     double *U = odhs__malloc_array(dc ? R * (m <= R ? m : R) + 1 : 1, sizeof *U);
     double *vt = odhs__malloc_array(m * m + 1, sizeof *vt);
     double *sv = odhs__malloc_array(ns + 1, sizeof *sv);
     double *sup = odhs__malloc_array(ns + 1, sizeof *sup);
     int st = ODHS_OK;
-    if (!A || !A2 || !U || !vt || !sv || !sup) {
+    if (!A || !U || !vt || !sv || !sup) {
         st = ODHS_E_NOMEM;
         goto done;
-    }
-    /* column a = s_a^T: -n on i's rows, +n on j's (a wall has no block) */
-    for (size_t a = 0; a < m; ++a) {
-        size_t c = idx[a];
-        const double *nc = net->nrm + c * d;
-        for (int k = 0; k < d; ++k) {
-            A[a * R + row[net->ci[c]] * d + k] = -nc[k];
-            if (net->cj[c] < n) A[a * R + row[net->cj[c]] * d + k] = nc[k];
-        }
-        if (rv) A[a * R + R - 1] = rv[a];
     }
     if (m < 2 || m > R + 1) {
         st = ODHS_E_SINGULAR; /* no kernel, or more than a one-dimensional one */
@@ -84,14 +92,14 @@ static int null_dense(const odhs_network *net, const size_t *idx, size_t m, cons
     }
     /* up to DENSE_MAX contacts divide and conquer (dgesdd) first: 2.2
      * times faster than dgesvd at m = 500 (its left vectors are computed but
-     * not used); it overwrites A, so a copy is kept for dgesvd, which takes
-     * over if it fails. All m right vectors: jobz 'S' gives min(R, m) */
+     * not used); dgesvd takes over, on a fresh A, if it fails. All m right
+     * vectors: jobz 'S' gives min(R, m) */
     lapack_int info = 1;
+    fill_ST(net, idx, m, rv, row, R, A);
     if (dc) {
-        memcpy(A2, A, R * m * sizeof *A);
         info = LAPACKE_dgesdd(LAPACK_COL_MAJOR, m <= R ? 'S' : 'A', (lapack_int)R, (lapack_int)m, A, (lapack_int)R, sv,
                               U, (lapack_int)R, vt, (lapack_int)m);
-        if (info != 0) memcpy(A, A2, R * m * sizeof *A);
+        if (info != 0) fill_ST(net, idx, m, rv, row, R, A);
     }
     if (info != 0)
         info = LAPACKE_dgesvd(LAPACK_COL_MAJOR, 'N', 'A', (lapack_int)R, (lapack_int)m, A, (lapack_int)R, sv, NULL, 1,
@@ -111,7 +119,6 @@ static int null_dense(const odhs_network *net, const size_t *idx, size_t m, cons
 done:
     odhs__free(row);
     odhs__free(A);
-    odhs__free(A2);
     odhs__free(U);
     odhs__free(vt);
     odhs__free(sv);

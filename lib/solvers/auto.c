@@ -296,6 +296,19 @@ static int pinv_sym_solve(auto_state *s, double *A, size_t n, const double *y, d
     return ODHS_OK;
 }
 
+/* N, dense and column-major, into s->A (nc x nc, then nd entries of work) */
+static void fill_N(auto_state *s, const odhs_network *net)
+{
+    size_t nc = net->nc;
+    double *w = s->A + nc * nc;
+    memset(s->rhs, 0, nc * sizeof *s->rhs);
+    for (size_t c = 0; c < nc; ++c) {
+        s->rhs[c] = 1.0;
+        odhs__net_N(net, s->rhs, s->A + c * nc, w);
+        s->rhs[c] = 0.0;
+    }
+}
+
 /* minimum-norm least squares, dense SVD route (g given: on S^T; else on N,
  * from N's eigendecomposition, with the SVD when that fails) */
 static int lsq_svd(auto_state *s, const odhs_network *net, const double *b, const double *g, double *x, long rank)
@@ -313,19 +326,12 @@ static int lsq_svd(auto_state *s, const odhs_network *net, const double *b, cons
         return pinv_solve(s, s->A, nd, nc, g, x, rank, s->lsq_rcond);
     }
     if ((st = grow(&s->A, &s->Acap, nc * nc + nd)) || (st = grow(&s->rhs, &s->rcap, nc))) return st;
-    double *w = s->A + nc * nc;
     double rc = fmax(s->lsq_rcond * s->lsq_rcond, 1e-13);
-    for (int pass = 0; pass < 2; ++pass) {
-        memset(s->rhs, 0, nc * sizeof *s->rhs);
-        for (size_t c = 0; c < nc; ++c) {
-            s->rhs[c] = 1.0;
-            odhs__net_N(net, s->rhs, s->A + c * nc, w);
-            s->rhs[c] = 0.0;
-        }
-        st = pass ? pinv_solve(s, s->A, nc, nc, b, x, rank, rc) : pinv_sym_solve(s, s->A, nc, b, x, rank, rc);
-        if (st != ODHS_E_INTERNAL) break;
-    }
-    return st;
+    fill_N(s, net);
+    st = pinv_sym_solve(s, s->A, nc, b, x, rank, rc);
+    if (st != ODHS_E_INTERNAL) return st;
+    fill_N(s, net); /* dsyevd failed on it: the SVD takes a fresh copy */
+    return pinv_solve(s, s->A, nc, nc, b, x, rank, rc);
 }
 
 static int primary_for(const auto_state *s, size_t nc)

@@ -509,7 +509,8 @@ static int pcg_precond(pcg_state *s, size_t nc, const double *r, double *z)
     double *bx = s->work[0]->x;
     memset(bx, 0, s->cap * sizeof *bx);
     for (size_t c = 0; c < nc; ++c) bx[s->c2s[c]] = r[c];
-    if (!cholmod_solve2(CHOLMOD_A, s->L, s->work[0], NULL, &s->work[1], NULL, &s->work[2], &s->work[3], &s->c)) return odhs__cm_error(&s->c);
+    if (!cholmod_solve2(CHOLMOD_A, s->L, s->work[0], NULL, &s->work[1], NULL, &s->work[2], &s->work[3], &s->c))
+        return odhs__cm_error(&s->c);
     const double *xx = s->work[1]->x;
     for (size_t c = 0; c < nc; ++c) z[c] = xx[s->c2s[c]];
     return ODHS_OK;
