@@ -6,7 +6,7 @@
 
 #include "stepper/stepper.h"
 
-/* gaps within this many ulps of the longest box edge are at round-off */
+/* gaps below CORR_ULPS * DBL_EPSILON * (longest box edge) are at round-off */
 #define CORR_ULPS 2.0
 
 /* Contacts the correction leaves out for a while (below): at most OUT_MAX */
