@@ -3,13 +3,16 @@
  * falls (analytic two-disc case, a 2D shear), invariants after every step
  * (no overlap, no negative force, power balance) in 2D and 3D at fixed
  * volume and fixed pressure, rate invariance, settings. */
+#define _POSIX_C_SOURCE 200809L
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "odhs.h"
+#include "internal.h" /* the stepper's contact flags (test_contact_flags) */
 
 typedef struct {
     odhs_system *sys;
@@ -826,6 +829,79 @@ START_TEST(test_correction_round_off)
 }
 END_TEST
 
+/* The collision sweep skips the neighbour pairs flagged as contacts
+ * (predict.c, since 0.2.18); the flags follow the network through its
+ * change log. After every step, correction, reset, checkpoint restore and
+ * a log overflow, the flags must be exactly the network's contacts among
+ * the neighbour pairs: a flag on a pair that is not a contact would hide a
+ * collision. 2D at fixed volume and at fixed pressure, and 3D. */
+static void check_flags(odhs_stepper *st, const char *when, size_t *nflag)
+{
+    ck_assert_msg(odhs__st_pair_flags(st) == 1, "%s: flags unavailable", when);
+    const odhs_network *net = odhs_stepper_network(st);
+    size_t nf = 0;
+    for (size_t p = 0; p < st->npairs; ++p) {
+        const int in = odhs__net_find(net, st->pi[p], st->pj[p]) != SIZE_MAX;
+        ck_assert_msg(st->pflag[p] == in, "%s: pair %zu (%zu, %zu) flagged %d, contact %d", when, p, st->pi[p],
+                      st->pj[p], st->pflag[p], in);
+        nf += in;
+    }
+    *nflag = nf;
+}
+
+static void flags_run(const odhs_system *start, double p, int steps, const char *name)
+{
+    bscene s;
+    sheared(&s, start, 1.0, p, ODHS_INTEGRATOR_HEUN, 0.0, 0.0);
+    size_t nf = 0, nmin = SIZE_MAX, nmax = 0;
+    uint64_t log0 = 0;
+    for (int k = 0; k < steps; ++k) {
+        int rc = odhs_stepper_step(s.st, NULL);
+        ck_assert_msg(rc == ODHS_OK, "%s: step %d: %s", name, k, odhs_stepper_errmsg(s.st));
+        if (k == 0) log0 = s.st->net->log_n;
+        check_flags(s.st, name, &nf);
+        nmin = nf < nmin ? nf : nmin;
+        nmax = nf > nmax ? nf : nmax;
+    }
+    const uint64_t changes = s.st->net->log_n - log0;
+    ck_assert_int_eq(odhs_stepper_correct(s.st), ODHS_OK);
+    check_flags(s.st, "after a correction", &nf);
+    /* a reset detects the network anew (more changes than the log holds) */
+    ck_assert_int_eq(odhs_stepper_reset(s.st), ODHS_OK);
+    check_flags(s.st, "after a reset", &nf);
+    /* a restored checkpoint: its own neighbour list, flags built anew */
+    char path[] = "/tmp/odhs_flags_XXXXXX";
+    int fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    ck_assert_int_eq(odhs_checkpoint_write(s.st, path), ODHS_OK);
+    bscene r;
+    ck_assert_int_eq(odhs_solver_create_by_name("dense", &r.sol), ODHS_OK);
+    ck_assert_int_eq(odhs_checkpoint_read(path, r.sol, &r.sys, &r.drv, &r.st, NULL, 0), ODHS_OK);
+    unlink(path);
+    for (int k = 0; k < 20; ++k) {
+        ck_assert_int_eq(odhs_stepper_step(r.st, NULL), ODHS_OK);
+        check_flags(r.st, "after a restore", &nf);
+    }
+    fprintf(stderr, "[batched] contact flags, %s: %d steps, %llu contact changes, %zu-%zu flagged of %zu pairs\n",
+            name, steps, (unsigned long long)changes, nmin, nmax, s.st->npairs);
+    ck_assert_msg(nmin > 0 && changes > 20, "%s: %zu flagged, %llu changes", name, nmin,
+                  (unsigned long long)changes);
+    bscene_free(&r);
+    bscene_free(&s);
+}
+
+START_TEST(test_contact_flags)
+{
+    odhs_system *p2 = packing(2, 128, 0.80, 7), *p3 = packing(3, 64, 0.60, 7);
+    flags_run(p2, 0.0, 300, "2D fixed volume");
+    flags_run(p2, 100.0, 300, "2D p = 100");
+    flags_run(p3, 0.0, 200, "3D fixed volume");
+    odhs_system_destroy(p2);
+    odhs_system_destroy(p3);
+}
+END_TEST
+
 Suite *make_batched_suite(void)
 {
     Suite *s = suite_create("batched");
@@ -846,6 +922,7 @@ Suite *make_batched_suite(void)
     tcase_add_test(tc, test_reset_block_rewire);
     tcase_add_test(tc, test_correction_block_pass);
     tcase_add_test(tc, test_correction_round_off);
+    tcase_add_test(tc, test_contact_flags);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -194,6 +194,16 @@ static void adj_remove(odhs_network *net, size_t i, size_t j)
         }
 }
 
+/* one contact change into the network's log (network.h) */
+static void net_log(odhs_network *net, size_t i, size_t j, int add)
+{
+    const size_t k = (size_t)(net->log_n % ODHS__NET_LOG);
+    net->log_i[k] = i;
+    net->log_j[k] = j;
+    net->log_add[k] = (unsigned char)add;
+    net->log_n++;
+}
+
 size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
 {
     if (kind == ODHS_CONTACT_PERMANENT && odhs__net_body_reserve(net)) return SIZE_MAX;
@@ -220,6 +230,7 @@ size_t odhs__net_add(odhs_network *net, size_t i, size_t j, int kind)
     net->adj[i][net->adjn[i]++] = j;
     net->adj[j][net->adjn[j]++] = i;
     odhs__net_core_added(net, i, j);
+    net_log(net, i, j, 1);
     net->version++;
     net->topo++;
     return c;
@@ -255,6 +266,7 @@ static void hash_set(odhs_network *net, uint64_t key, size_t val)
 
 void odhs__net_remove_at(odhs_network *net, size_t k)
 {
+    net_log(net, net->ci[k], net->cj[k], 0);
     hash_delete(net, pair_key(net, net->ci[k], net->cj[k]));
     adj_remove(net, net->ci[k], net->cj[k]);
     adj_remove(net, net->cj[k], net->ci[k]);

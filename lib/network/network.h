@@ -8,6 +8,8 @@
 
 #include "system/system.h"
 
+#define ODHS__NET_LOG 256
+
 struct odhs_network {
     int dim;
     size_t n;        /* particles */
@@ -22,6 +24,15 @@ struct odhs_network {
     uint64_t *hkey;  /* 0 = empty, else i*n + j + 1 */
     size_t *hval;
     uint64_t version; /* bumped on every change of contacts or geometry */
+    /* the last ODHS__NET_LOG contact changes, for caches that follow the
+     * network (the stepper's contact flags of its neighbour pairs,
+     * predict.c): change k (counted from 0 since the handle was made) is
+     * pair log_i < log_j at k % ODHS__NET_LOG, log_add 1 if it was added and
+     * 0 if removed; log_n counts every change. A cache behind by more than
+     * ODHS__NET_LOG changes rebuilds. */
+    size_t log_i[ODHS__NET_LOG], log_j[ODHS__NET_LOG];
+    unsigned char log_add[ODHS__NET_LOG];
+    uint64_t log_n;
     /* constrained subset (the (d+1)-core of the contact graph), in integers:
      * peeled incrementally on every removal, rebuilt lazily after additions */
     size_t **adj;          /* per particle: partners */

@@ -85,6 +85,7 @@ static int check_stepper(odhs__ckpt_in *in, const odhs_stepper *st)
 /* the neighbour list: npairs pairs i < j < n */
 static int read_pairs(odhs__ckpt_in *in, odhs_stepper *st, uint64_t npairs)
 {
+    st->pflag_state = 0; /* new pairs (also if they fail): the contact flags are built anew */
     if (npairs) {
         size_t *a = odhs__realloc(st->pi, (size_t)npairs * sizeof *a);
         if (a) st->pi = a;

@@ -79,7 +79,7 @@ void odhs_stepper_destroy(odhs_stepper *st)
     void *arrays[] = {st->disps, st->U0,  st->Ua,    st->Up, st->F,  st->U,     st->tmp,   st->cb,
                       st->cx,    st->pi,  st->pj,    st->disp, st->rem, st->fpj,  st->pj_res, st->chg,
                       st->xs,    st->sci, st->scj,   st->skind, st->sf, st->fr,   st->srest, st->ev,
-                      st->wsnap, st->pre_b, st->pre_f, st->bviol};
+                      st->wsnap, st->pre_b, st->pre_f, st->bviol, st->pflag, st->ppart, st->pidx};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; ++k) odhs__free(arrays[k]);
     odhs__free(st);
 }

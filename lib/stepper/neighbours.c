@@ -24,6 +24,7 @@ int odhs__st_build_neighbours(odhs_stepper *st)
                      Lmin, 2.0 * s->rmax);
     st->skin = skin;
     st->rc = 2.0 * s->rmax + skin;
+    st->pflag_state = 0; /* new pairs (also if the search fails): the contact flags are built anew */
     if (odhs__pair_list(st->dim, st->n, s->x, s->r, s->rmax, s->L, s->gamma, skin, &st->pi, &st->pj, &st->npairs,
                         &st->pcap))
         return odhs__sterr(st, ODHS_E_NOMEM, "out of memory");

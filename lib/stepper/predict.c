@@ -104,20 +104,83 @@ static double predict_walls(const odhs_stepper *st, const double *G, const doubl
     return best;
 }
 
+/* ---- contact flags of the neighbour pairs ------------------------------------
+ * A contact never collides, but the sweep below only learnt that from the
+ * network's hash after computing the pair's minimum image and chord: at 2D
+ * N = 10^4, 15 000 of the 25 000 neighbour pairs are contacts. st->pflag
+ * marks them. It follows the network through its change log (network.h),
+ * applied here before a sweep; a flag is set only for a pair the network
+ * holds, so a stale or missing flag can only send a contact down the full
+ * path, never skip a pair that is not one. */
+
+/* pair index of (i, j), i < j, in the neighbour list; SIZE_MAX if absent */
+static size_t pair_index(const odhs_stepper *st, size_t i, size_t j)
+{
+    for (size_t q = st->ppart[i]; q < st->ppart[i + 1]; ++q)
+        if (st->pj[st->pidx[q]] == j) return st->pidx[q];
+    return SIZE_MAX;
+}
+
+/* the flags up to date: 1 when usable, 0 when not (out of memory) */
+int odhs__st_pair_flags(odhs_stepper *st)
+{
+    const odhs_network *net = st->net;
+    const size_t n = st->n, np = st->npairs;
+    if (st->pflag_state == 2) return 0;
+    if (st->pflag_state == 1 && st->pflag_log == net->log_n) return 1;
+    if (st->pflag_state == 0) {
+        /* the index of a new neighbour list (pairs i < j) */
+        if (odhs__reserve((void **)&st->pflag, &st->pflag_cap, np + 1, 1) ||
+            odhs__reserve((void **)&st->ppart, &st->ppart_cap, n + 1, sizeof *st->ppart) ||
+            odhs__reserve((void **)&st->pidx, &st->pidx_cap, np + 1, sizeof *st->pidx)) {
+            st->pflag_state = 2;
+            return 0;
+        }
+        memset(st->ppart, 0, (n + 1) * sizeof *st->ppart);
+        for (size_t p = 0; p < np; ++p) st->ppart[st->pi[p] + 1]++;
+        for (size_t i = 0; i < n; ++i) st->ppart[i + 1] += st->ppart[i];
+        for (size_t p = 0; p < np; ++p) st->pidx[st->ppart[st->pi[p]]++] = p;
+        for (size_t i = n; i > 0; --i) st->ppart[i] = st->ppart[i - 1];
+        st->ppart[0] = 0;
+    }
+    if (st->pflag_state == 0 || net->log_n - st->pflag_log > ODHS__NET_LOG) {
+        /* from the network's contacts */
+        memset(st->pflag, 0, np);
+        for (size_t c = 0; c < net->nc; ++c) {
+            if (net->cj[c] >= n) continue; /* a wall */
+            size_t p = pair_index(st, net->ci[c], net->cj[c]);
+            if (p != SIZE_MAX) st->pflag[p] = 1;
+        }
+    } else {
+        /* the changes since, in their order */
+        for (uint64_t k = st->pflag_log; k < net->log_n; ++k) {
+            const size_t e = (size_t)(k % ODHS__NET_LOG), i = net->log_i[e], j = net->log_j[e];
+            if (j >= n) continue;
+            size_t p = pair_index(st, i, j);
+            if (p != SIZE_MAX) st->pflag[p] = net->log_add[e];
+        }
+    }
+    st->pflag_log = net->log_n;
+    st->pflag_state = 1;
+    return 1;
+}
+
 /* ---- collision prediction ------------------------------------------------ */
 /* earliest time in [0, horizon] at which a non-contact pair touches when
  * separations move as d + t (G d + vel_j - vel_i). A touching pair counts
  * when it approaches on the chord (current = 0), in the current velocities
  * (1), or in either (2: the caller's scheme repeats a step whose chord
  * disagrees with the current velocities). */
-double odhs__st_predict(const odhs_stepper *st, const double *G, const double *vel, double horizon,
-                      double vtol, int moving, int current, size_t *pi, size_t *pj)
+double odhs__st_predict(odhs_stepper *st, const double *G, const double *vel, double horizon, double vtol,
+                        int moving, int current, size_t *pi, size_t *pj)
 {
     const odhs_system *s = st->sys;
     int dim = st->dim;
     double best = horizon;
     *pi = *pj = SIZE_MAX;
+    const unsigned char *contact = odhs__st_pair_flags(st) ? st->pflag : NULL;
     for (size_t p = 0; p < st->npairs; ++p) {
+        if (contact && contact[p]) continue; /* in the network: skipped below too */
         size_t i = st->pi[p], j = st->pj[p];
         double d[3], gd[3] = {0, 0, 0}, w[3] = {0, 0, 0};
         odhs__st_min_sep(st, i, j, d);

@@ -83,6 +83,18 @@ struct odhs_stepper {
     double skin, rc;
     double *disp;     /* non-affine displacement since the last build (nd) */
     double M[9];      /* affine deformation since the last build */
+    /* contact flags of the neighbour pairs (predict.c): pflag[p] = 1 only if
+     * pair p is a contact, so that the collision sweep skips it at once;
+     * kept up to date from the network's change log (pflag_log: its count
+     * the flags follow). ppart/pidx: each particle's pairs as the smaller
+     * index (CSR). pflag_state: 0 = to build (a new neighbour list), 1 =
+     * current as of pflag_log, 2 = unavailable until the next list (out of
+     * memory: the sweep then asks the network's hash, as without flags) */
+    unsigned char *pflag;
+    size_t *ppart, *pidx;
+    size_t pflag_cap, ppart_cap, pidx_cap;
+    uint64_t pflag_log;
+    int pflag_state;
     /* rewiring */
     odhs_change *rem; /* pairs removed during the current rewiring */
     size_t nrem, remcap;
@@ -302,7 +314,10 @@ int odhs__st_jam_finish(odhs_stepper *st);
 int odhs__st_build_neighbours(odhs_stepper *st);
 double odhs__st_skin_used(const odhs_stepper *st);
 double odhs__st_skin_rate(const odhs_stepper *st, const double *G, const double *vel);
-double odhs__st_predict(const odhs_stepper *st, const double *G, const double *vel, double horizon, double vtol,
+/* bring st->pflag up to date with the network (predict.c): 1 when the
+ * flags are usable, 0 when not (out of memory until the next list) */
+int odhs__st_pair_flags(odhs_stepper *st);
+double odhs__st_predict(odhs_stepper *st, const double *G, const double *vel, double horizon, double vtol,
                         int moving, int current, size_t *pi, size_t *pj);
 void odhs__st_advance(odhs_stepper *st, const double *G, const double *vel, double t);
 void odhs__st_advance_walls(odhs_stepper *st, double t);
