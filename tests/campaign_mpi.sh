@@ -32,19 +32,23 @@ echo "== MPI run on 2 ranks, killed mid-way"
 "${mpirun[@]}" -np 2 "$bin/sweep_mpi" --campaign "$campaign" --out "$work/mpi" > "$work/mpi1.out" 2> "$work/mpi1.err" &
 mpirun_pid=$!
 # Kill point: at least 2 runs finished and a checkpoint of a run that is far
-# from its end (under 40 of its 61 series rows written), so that the run is
-# certainly unfinished when the kill lands.
+# from its end (under 50 of its 61 series rows written: at least 0.1 of strain,
+# a few hundred milliseconds, still to go), so that the run is certainly
+# unfinished when the kill lands. Polled every 20 ms: the window is about half
+# a second wide on a 2-core machine.
 killed=0 ranks=
-for _ in $(seq 1 1200); do
-    sleep 0.05
+for _ in $(seq 1 3000); do
+    sleep 0.02
     kill -0 $mpirun_pid 2>/dev/null || break
-    [ -n "$ranks" ] || ranks=$(children $mpirun_pid)
+    # re-read until both ranks are there: mpirun may start them one at a time,
+    # and a list read between the two would never reach the kill below
+    [ "$(echo $ranks | wc -w)" -eq 2 ] || ranks=$(children $mpirun_pid)
     nres=$(ls "$work"/mpi/runs/*/result.csv 2>/dev/null | wc -l)
     early=0
     for ck in "$work"/mpi/runs/*/checkpoint.odhs; do
         [ -e "$ck" ] || continue
         rows=$(wc -l < "${ck%checkpoint.odhs}series.csv" 2>/dev/null || echo 999)
-        [ "$rows" -lt 40 ] && early=1
+        [ "$rows" -lt 50 ] && early=1
     done
     if [ "$nres" -ge 2 ] && [ $early -eq 1 ] && [ "$(echo $ranks | wc -w)" -eq 2 ]; then
         nck=$(ls "$work"/mpi/runs/*/checkpoint.odhs 2>/dev/null | wc -l)
@@ -55,7 +59,8 @@ for _ in $(seq 1 1200); do
     fi
 done
 wait $mpirun_pid; rc=$?
-[ $killed -eq 1 ] && ok "killed mid-way (mpirun exit $rc)" || bad "the campaign ended before the kill point (exit $rc)"
+[ $killed -eq 1 ] && ok "killed mid-way (mpirun exit $rc)" \
+    || bad "the campaign ended before the kill point (exit $rc; last poll: $nres results, early checkpoint $early, ranks '$(echo $ranks)')"
 nres=$(ls "$work"/mpi/runs/*/result.csv 2>/dev/null | wc -l)
 nck=$(ls "$work"/mpi/runs/*/checkpoint.odhs 2>/dev/null | wc -l)
 nruns=$(grep -c '^[0-9]' "$campaign")
