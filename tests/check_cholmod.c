@@ -958,17 +958,27 @@ static odhs_system *cm_scene(int dim, size_t n, double phi, uint64_t seed, odhs_
     return sys;
 }
 
+/* a stepper shearing a clone of base at rate 1 with the given solver */
+static odhs_stepper *cm_shear_stepper(const odhs_system *base, odhs_solver *sol, odhs_system **sys,
+                                      odhs_driver **drv)
+{
+    odhs_stepper *st = NULL;
+    *sys = NULL;
+    *drv = NULL;
+    ck_assert_int_eq(odhs_system_clone(base, sys), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_shear_rate(*drv, 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(*sys, *drv, sol, &st), ODHS_OK);
+    return st;
+}
+
 /* shear a clone of base with the given solver for nsteps steps; returns the
  * shear stress after every step (malloc'ed), event count in *events */
 static double *cm_shear_series(const odhs_system *base, odhs_solver *sol, int nsteps, uint64_t *events)
 {
-    odhs_system *sys = NULL;
-    odhs_driver *drv = NULL;
-    odhs_stepper *st = NULL;
-    ck_assert_int_eq(odhs_system_clone(base, &sys), ODHS_OK);
-    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
-    ck_assert_int_eq(odhs_driver_set_shear_rate(drv, 1.0), ODHS_OK);
-    ck_assert_int_eq(odhs_stepper_create(sys, drv, sol, &st), ODHS_OK);
+    odhs_system *sys;
+    odhs_driver *drv;
+    odhs_stepper *st = cm_shear_stepper(base, sol, &sys, &drv);
     /* the paper's fixed-step scheme: the series of the backends are compared step by step */
     ck_assert_int_eq(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_EULER), ODHS_OK);
     ck_assert_int_eq(odhs_stepper_set_dt(st, 2e-3), ODHS_OK);
@@ -1032,6 +1042,68 @@ START_TEST(test_stepper_shear)
 }
 END_TEST
 
+/* A shear run's events at N = 512: each new contact enters the factor in a
+ * free slot, and a column of L that outgrows its room moves to the end of the
+ * factor and leaves a hole, so the allocation outgrows PCG_NZMAX_GROWTH (2.5)
+ * times the fresh factor's long before the fill doubles. Since 0.2.19 the
+ * backend packs the factor then instead of refactoring: with periodic
+ * refactoring off, 0.2.18 refactored 24 times over this run and 0.2.19 13
+ * times. The run must equal the direct backend's (the same events, the same
+ * stress to 1e-9). */
+static void cm_pack_run(const odhs_system *base, odhs_solver *sol, double *sxy, uint64_t *events)
+{
+    odhs_system *sys;
+    odhs_driver *drv;
+    odhs_stepper *st = cm_shear_stepper(base, sol, &sys, &drv);
+    int rc = odhs_stepper_run_until_strain(st, 0.05);
+    ck_assert_msg(rc == ODHS_OK, "%s: %d (%s)", odhs_solver_name(sol), rc, odhs_stepper_errmsg(st));
+    uint64_t steps, coll, open;
+    ck_assert_int_eq(odhs_stepper_counts(st, &steps, &coll, &open), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_shear_stress(st, sxy), ODHS_OK);
+    *events = coll + open;
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+}
+
+START_TEST(test_pcg_pack_shear)
+{
+    odhs_system *base = NULL;
+    odhs_driver *drv = NULL;
+    odhs_stepper *st = NULL;
+    odhs_solver *au = cm_by_name("auto");
+    ck_assert_int_eq(odhs_system_create(2, 512, &base), ODHS_OK);
+    ck_assert_int_eq(odhs_system_set_radii_bidisperse(base, 0.5, 1.4, 0.03, 5), ODHS_OK);
+    ck_assert_int_eq(odhs_system_place_random(base, 0.45, 6), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_create(&drv), ODHS_OK);
+    ck_assert_int_eq(odhs_driver_set_compression_rate(drv, 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_create(base, drv, au, &st), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_set_integrator(st, ODHS_INTEGRATOR_BATCHED), ODHS_OK);
+    ck_assert_int_eq(odhs_stepper_run_until_packing_fraction(st, 0.80), ODHS_OK);
+    odhs_stepper_destroy(st);
+    odhs_driver_destroy(drv);
+    odhs_solver_destroy(au);
+    odhs_solver *pc = cm_new(&odhs_solver_type_cholmod_pcg), *ch = cm_new(&odhs_solver_type_cholmod);
+    ck_assert_int_eq(odhs_solver_set_param(pc, "refactor_every", 0.0), ODHS_OK);
+    double spc, sch;
+    uint64_t epc, ech;
+    cm_pack_run(base, pc, &spc, &epc);
+    cm_pack_run(base, ch, &sch, &ech);
+    cm_note("pack: %llu events, sigma_xy %.12g (cholmod %.12g); packs %g, factorizations %g, updates %g",
+            (unsigned long long)epc, spc, sch, cm_stat(pc, "packs"), cm_stat(pc, "factorizations"),
+            cm_stat(pc, "updates"));
+    ck_assert_msg(epc > 300, "only %llu events", (unsigned long long)epc);
+    ck_assert_uint_eq(epc, ech);
+    ck_assert_msg(fabs(spc - sch) <= 1e-9 * fabs(sch), "sigma_xy %.15g against cholmod's %.15g", spc, sch);
+    ck_assert_msg(cm_stat(pc, "packs") >= 1.0, "the factor was never packed");
+    ck_assert_msg(cm_stat(pc, "factorizations") <= 18.0, "%g factorisations (0.2.18: 24)",
+                  cm_stat(pc, "factorizations"));
+    odhs_solver_destroy(pc);
+    odhs_solver_destroy(ch);
+    odhs_system_destroy(base);
+}
+END_TEST
+
 Suite *make_cholmod_suite(void)
 {
     Suite *s = suite_create("cholmod");
@@ -1065,6 +1137,7 @@ Suite *make_cholmod_suite(void)
     tc = tcase_create("stepper");
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_stepper_shear);
+    tcase_add_test(tc, test_pcg_pack_shear);
     suite_add_tcase(s, tc);
     return s;
 }

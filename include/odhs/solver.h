@@ -80,14 +80,17 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
  *  module (cholmod_rowadd / cholmod_rowdel; GPL-2.0-or-later) when contacts
  *  appear or disappear, and refactored after "refactor_every" geometry
  *  changes (default 50), when CG needs more than "refactor_iterations"
- *  (default 40), when the slots run out or the fill doubles, and when more
+ *  (default 40), when the slots run out or the fill doubles, when the
+ *  factor's allocation passes 4 times that of the fresh factor (since 0.2.19
+ *  the factor is packed first when it passes 2.5 times), and when more
  *  than "update_max" (Nc + 64) contacts changed at once (default 0.125, in
  *  [0, 1]; since 0.2.14; the batched integrator lowers it to 1/256 inside
  *  its contact problems). Exact (one iteration) while the geometry is
  *  unchanged, e.g. during rewiring.
  *  Parameters: "tol" (default 1e-12), "maxiter", "min_rcond",
  *  "refactor_every", "refactor_iterations", "update_max". Statistics: "iterations",
- *  "updates", "factorizations", "analyses", "rcond", "nnz_L", "capacity". */
+ *  "updates", "packs" (since 0.2.19), "factorizations", "analyses", "rcond",
+ *  "nnz_L", "capacity". */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
 /** SuiteSparseQR on A = S^T (only in builds with SuiteSparse; otherwise
  *  "spqr" gives ODHS_E_NOTINSTALLED): solve_ls computes the least-squares
