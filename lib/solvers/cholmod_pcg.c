@@ -117,8 +117,9 @@ typedef struct {
     double iterations, updates, factorizations, analyses, rcond, status, packs;
 } pcg_state;
 
-/* insertions stop (and setup refactors) once the factor's allocation
- * exceeds this multiple of the fresh factor's */
+/* past PCG_NZMAX_GROWTH times the fresh factor's allocation the factor is
+ * packed (pcg_reclaim); insertions stop (and setup refactors) past
+ * PCG_NZMAX_HARD times, or when the fill has doubled */
 #define PCG_NZMAX_GROWTH 2.5
 #define PCG_NZMAX_HARD 4.0
 
