@@ -18,6 +18,8 @@
  *   batched    ODHS_INTEGRATOR_BATCHED with its defaults (tol 1e-3, dt 5e-2:
  *              steps set by the tolerance), over strain 0.3
  *   tight      the same at tol 1e-4 (ODHS_BENCH_TIGHT_TOL: another)
+ * ODHS_BENCH_SUPERNODAL=-1|0|1 sets the "supernodal" parameter of auto's
+ * cholmod-pcg (0.2.20; 0, the default, is the simplicial route).
  * Cost per unit strain = CPU seconds of the process / strain. Fitted
  * exponents (least squares of log cost on log N) and an SVG plot.
  *
@@ -75,6 +77,15 @@
 #include "../examples/plot.h"
 
 enum { S_EXACT, S_BATCHED, S_TIGHT, S_COUNT };
+/* ODHS_BENCH_SUPERNODAL: the "supernodal" parameter of auto's cholmod-pcg
+ * (-1, 0 = the default, 1) for the shear and compression runs */
+static double pcg_supernodal;
+static int auto_solver(odhs_solver **sol)
+{
+    int rc = odhs_solver_create_by_name("auto", sol);
+    if (!rc && pcg_supernodal != 0.0) rc = odhs_solver_set_param(*sol, "supernodal", pcg_supernodal);
+    return rc;
+}
 /* strain of the scan's warm-up (batched): ODHS_BENCH_WARMUP, default 0.3.
  * The exact setting's cost is measured right after it, over ~1000 events:
  * after 0.3 the packing is still in the transient from the compression
@@ -106,7 +117,7 @@ static int compress_seed(int dim, size_t n, double phi, unsigned seed, odhs_syst
     int rc = odhs_system_create(dim, n, &sys);
     if (!rc) rc = odhs_system_set_radii_bidisperse(sys, 0.5, 1.4, 0.03, seed);
     if (!rc) rc = odhs_system_place_random(sys, dim == 2 ? 0.45 : 0.30, seed + 1);
-    if (!rc) rc = odhs_solver_create_by_name("auto", &sol);
+    if (!rc) rc = auto_solver(&sol);
     if (!rc) rc = odhs_driver_create(&drv);
     if (!rc) rc = odhs_driver_set_compression_rate(drv, 1.0);
     if (!rc) rc = odhs_stepper_create(sys, drv, sol, &st);
@@ -169,7 +180,7 @@ static int start_of(int dim, size_t n, size_t nbuild, odhs_system **out)
 static odhs_stepper *shear_stepper(odhs_system *sys, int setting, odhs_solver **sol, odhs_driver **drv)
 {
     odhs_stepper *st = NULL;
-    odhs_solver_create_by_name("auto", sol);
+    auto_solver(sol);
     odhs_driver_create(drv);
     odhs_driver_set_shear_rate(*drv, 1.0);
     odhs_stepper_create(sys, *drv, *sol, &st);
@@ -311,21 +322,30 @@ static int memory(int dim, size_t n, size_t nbuild, int nsteps)
                r0.ru_maxrss / 1024.0);
         fflush(stdout);
     }
+    double g0 = 0.0;
+    odhs_stepper_strain(st, &g0);
     for (int k = 0; k < nsteps && !rc; ++k) {
         rc = odhs_stepper_step(st, NULL);
         struct rusage rk;
         getrusage(RUSAGE_SELF, &rk);
-        printf("# step %d: status %d, %.1f CPU s, peak RSS %.1f MiB\n", k + 1, rc, bench_cpu() - cs, rk.ru_maxrss / 1024.0);
+        double g = 0.0;
+        uint64_t ck = 0;
+        odhs_stepper_strain(st, &g);
+        odhs_stepper_counts(st, NULL, &ck, NULL);
+        printf("# step %d: status %d, %.1f CPU s, strain %.3e, %llu collisions, peak RSS %.1f MiB\n", k + 1, rc,
+               bench_cpu() - cs, g - g0, (unsigned long long)ck, rk.ru_maxrss / 1024.0);
         fflush(stdout);
     }
     uint64_t co = 0;
     odhs_stepper_counts(st, NULL, &co, NULL);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    printf("# memory: %dD N = %zu (start %.0f s wall), %d batched steps: status %d (%s), %llu collisions, %.1f CPU s, "
-           "peak RSS %.1f MiB\n",
-           dim, n, tb, nsteps, rc, rc ? odhs_stepper_errmsg(st) : "ok", (unsigned long long)co, bench_cpu() - c0,
-           ru.ru_maxrss / 1024.0);
+    double g1 = 0.0;
+    odhs_stepper_strain(st, &g1);
+    printf("# memory: %dD N = %zu (start %.0f s wall), %d batched steps: status %d (%s), strain %.3e, %llu collisions, "
+           "%.1f CPU s, peak RSS %.1f MiB\n",
+           dim, n, tb, nsteps, rc, rc ? odhs_stepper_errmsg(st) : "ok", g1 - g0, (unsigned long long)co,
+           bench_cpu() - c0, ru.ru_maxrss / 1024.0);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);
@@ -1214,6 +1234,14 @@ int main(int argc, char **argv)
         }
         snprintf(tight_name, sizeof tight_name, "batched tol %.0e", tight_tol);
         sname[S_TIGHT] = tight_name;
+    }
+    const char *sn = getenv("ODHS_BENCH_SUPERNODAL");
+    if (sn) {
+        pcg_supernodal = atof(sn);
+        if (pcg_supernodal != -1.0 && pcg_supernodal != 0.0 && pcg_supernodal != 1.0) {
+            fprintf(stderr, "batched: ODHS_BENCH_SUPERNODAL must be -1, 0 or 1\n");
+            return 2;
+        }
     }
     const char *wu = getenv("ODHS_BENCH_WARMUP");
     if (wu) {

@@ -867,7 +867,10 @@ START_TEST(test_params_stats)
     ck_assert_int_eq(odhs_solver_set_param(p, "refactor_iterations", 0.0), ODHS_E_INVALID);
     ck_assert_int_eq(odhs_solver_set_param(p, "refactor_iterations", 20.0), ODHS_OK);
     ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", 0.0), ODHS_OK);
-    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", 1.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", 1.0), ODHS_OK); /* since 0.2.20 */
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", -1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", 0.5), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", 2.0), ODHS_E_INVALID);
     ck_assert_int_eq(odhs_solver_set_param(p, "min_rcond", 1e-12), ODHS_OK);
     ck_assert_int_eq(odhs_solver_get_stat(p, "update_max", &v), ODHS_OK);
     ck_assert_double_eq(v, 0.125);
@@ -1042,6 +1045,99 @@ START_TEST(test_stepper_shear)
 }
 END_TEST
 
+/* cholmod-pcg's supernodal route (since 0.2.20): full factorisations by
+ * supernodes, converted to the simplicial LDL' that the updates modify. On a
+ * 3D network it must give what the simplicial route gives: the answer of the
+ * dense backend, an exact factor at a fixed geometry after single contact
+ * changes (three iterations at most), and agreement while the particles
+ * move; "supernodal" says which route the last full factorisation took. The
+ * same through "auto", which hands the parameter on. */
+static void cm_pcg_route(double mode, double *itmax_fixed, double *facs)
+{
+    cm_case c = cm_random_case(3, 200, 71, 30);
+    tu_rng rng;
+    tu_rng_seed(&rng, 72);
+    size_t nmax = c.nc + 40;
+    double *b = malloc(nmax * sizeof *b), *x = calloc(nmax, sizeof *x);
+    ck_assert(b && x);
+    odhs_solver *p = cm_new(&odhs_solver_type_cholmod_pcg);
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal", mode), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(p, "refactor_every", 0.0), ODHS_OK);
+    cm_rhs(c.net, &rng, b);
+    ck_assert(cm_vs_dense(p, c.net, b, x) < 1e-10);
+    ck_assert_double_eq(cm_stat(p, "supernodal"), mode == 1.0 ? 1.0 : 0.0);
+    ck_assert_double_eq(cm_stat(p, "factorizations"), 1.0);
+    double itmax = 0.0;
+    for (int op = 0; op < 60; ++op) { /* fixed geometry: updates keep the factor exact */
+        random_change(&c, &rng, c.nc - 10, c.nc + 12);
+        size_t nc = odhs_network_count(c.net);
+        cm_rhs(c.net, &rng, b);
+        memset(x, 0, nc * sizeof *x);
+        double d = cm_vs_dense(p, c.net, b, x);
+        ck_assert_msg(d < 1e-10, "supernodal %g, op %d: pcg vs dense %g", mode, op, d);
+        itmax = fmax(itmax, cm_stat(p, "iterations"));
+    }
+    ck_assert_msg(itmax <= 3.0, "supernodal %g: %g iterations with an exact updated factor", mode, itmax);
+    ck_assert_msg(cm_stat(p, "updates") >= 50.0, "supernodal %g: only %g updates", mode, cm_stat(p, "updates"));
+    *itmax_fixed = itmax;
+    ck_assert_int_eq(odhs_solver_set_param(p, "refactor_every", 10.0), ODHS_OK);
+    for (int op = 0; op < 40; ++op) { /* moving: an aged factor, refactored every 10 changes */
+        random_change(&c, &rng, c.nc - 10, c.nc + 12);
+        cm_jiggle(&c, &rng, 2e-3);
+        size_t nc = odhs_network_count(c.net);
+        cm_rhs(c.net, &rng, b);
+        memset(x, 0, nc * sizeof *x);
+        double d = cm_vs_dense(p, c.net, b, x);
+        ck_assert_msg(d < 1e-10, "supernodal %g, moving op %d: pcg vs dense %g", mode, op, d);
+    }
+    *facs = cm_stat(p, "factorizations");
+    ck_assert_msg(*facs >= 4.0, "supernodal %g: %g factorisations", mode, *facs);
+    ck_assert_double_eq(cm_stat(p, "supernodal"), mode == 1.0 ? 1.0 : 0.0);
+    odhs_solver_destroy(p);
+    free(b);
+    free(x);
+    cm_case_free(&c);
+}
+
+START_TEST(test_pcg_supernodal)
+{
+    double it0, it1, f0, f1;
+    cm_pcg_route(0.0, &it0, &f0);
+    cm_pcg_route(1.0, &it1, &f1);
+    cm_note("pcg supernodal route: fixed-geometry max iterations %g (simplicial %g), factorisations %g (%g)", it1,
+            it0, f1, f0);
+    /* a 3D packing: the supernodal route through auto, against the simplicial one */
+    odhs_network *net = NULL;
+    odhs_system *sys = cm_scene(3, 300, 0.62, 9, &net);
+    size_t nc = odhs_network_count(net);
+    tu_rng rng;
+    tu_rng_seed(&rng, 10);
+    double *b = malloc(nc * sizeof *b), *x0 = calloc(nc, sizeof *x0), *x1 = calloc(nc, sizeof *x1);
+    ck_assert(b && x0 && x1);
+    cm_rhs(net, &rng, b);
+    odhs_solver *a0 = cm_by_name("auto"), *a1 = cm_by_name("auto");
+    ck_assert_int_eq(odhs_solver_set_param(a1, "supernodal", 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(a1, "supernodal", 3.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_solve(a0, net, b, x0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_solve(a1, net, b, x1), ODHS_OK);
+    const char *bname = NULL, *why = NULL;
+    ck_assert_int_eq(odhs_solver_backend_name(a1, &bname, &why), ODHS_OK);
+    ck_assert_str_eq(bname, "cholmod-pcg");
+    ck_assert_double_eq(cm_stat(a0, "supernodal"), 0.0);
+    ck_assert_double_eq(cm_stat(a1, "supernodal"), 1.0);
+    double d = cm_reldiff(nc, x0, x1);
+    cm_note("pcg supernodal route, 3D packing N = 300, Nc = %zu: auto simplicial vs supernodal %.2e", nc, d);
+    ck_assert_msg(d < 1e-10, "auto: supernodal vs simplicial %g", d);
+    odhs_solver_destroy(a0);
+    odhs_solver_destroy(a1);
+    free(b);
+    free(x0);
+    free(x1);
+    odhs_network_destroy(net);
+    odhs_system_destroy(sys);
+}
+END_TEST
+
 /* A shear run's events at N = 512: each new contact enters the factor in a
  * free slot, and a column of L that outgrows its room moves to the end of the
  * factor and leaves a hole, so the allocation outgrows PCG_NZMAX_GROWTH (2.5)
@@ -1132,6 +1228,7 @@ Suite *make_cholmod_suite(void)
     tcase_add_test(tc, test_pcg_updates_moving_3d);
     tcase_add_test(tc, test_pcg_capacity);
     tcase_add_test(tc, test_pcg_bulk_insertions);
+    tcase_add_test(tc, test_pcg_supernodal);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("stepper");

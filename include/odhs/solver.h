@@ -88,9 +88,15 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
  *  its contact problems). Exact (one iteration) while the geometry is
  *  unchanged, e.g. during rewiring.
  *  Parameters: "tol" (default 1e-12), "maxiter", "min_rcond",
- *  "refactor_every", "refactor_iterations", "update_max". Statistics: "iterations",
- *  "updates", "packs" (since 0.2.19), "factorizations", "analyses", "rcond",
- *  "nnz_L", "capacity". */
+ *  "refactor_every", "refactor_iterations", "update_max", "supernodal"
+ *  (0, the default: full factorisations by the simplicial LDL' itself; since
+ *  0.2.20 also 1: by supernodes (LL' in dense blocks, converted to LDL'),
+ *  faster on 3D networks (docs/performance.md), and -1: CHOLMOD's choice, by
+ *  supernodes where its analysis predicts at least 40 flops per entry of
+ *  L). Statistics: "iterations", "updates", "packs" (since 0.2.19),
+ *  "supernodal" (since 0.2.20: 1 when the last full factorisation went by
+ *  supernodes), "factorizations", "analyses", "rcond", "nnz_L",
+ *  "capacity". */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
 /** SuiteSparseQR on A = S^T (only in builds with SuiteSparse; otherwise
  *  "spqr" gives ODHS_E_NOTINSTALLED): solve_ls computes the least-squares
@@ -144,7 +150,8 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
  *  SuiteSparse build choose as a build without it (1 in a build without
  *  gives ODHS_E_NOTINSTALLED). "tol" (since 0.2) is handed to the iterative
  *  backends cg and cholmod-pcg (their relative residual; default theirs,
- *  1e-12). Statistics: "backend" and "primary" (codes
+ *  1e-12); "update_max" (since 0.2.14) and "supernodal" (since 0.2.20) to
+ *  cholmod-pcg. Statistics: "backend" and "primary" (codes
  *  0 cg, 1 dense, 2 cholmod, 3 cholmod-pcg, 4 spqr, 5 lsq-svd, 6 lsq-cg,
  *  7 lsq-pcg (since 0.2.16); -1
  *  before the first solve), "fallbacks" (failed attempts followed by another

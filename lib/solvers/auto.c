@@ -85,6 +85,7 @@ typedef struct {
     double dense_max, dense_fallback_max, lsq_dense_max, lsq_rcond, check_tol;
     double tol;           /* "tol" of the iterative backends (cg, cholmod-pcg); 0: their own */
     double update_max;    /* "update_max" of cholmod-pcg */
+    double supernodal;    /* "supernodal" of cholmod-pcg (since 0.2.20) */
     int prefer, retry_after, retry_after_lsq;
     /* state */
     int sticky_backend;   /* backend to try first, -1: none */
@@ -157,6 +158,9 @@ static int auto_set_param(void *state, const char *key, double v)
     } else if (!strcmp(key, "update_max") && v >= 0.0 && v <= 1.0) {
         s->update_max = v;
         if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "update_max", v);
+    } else if (!strcmp(key, "supernodal") && (v == -1.0 || v == 0.0 || v == 1.0)) {
+        s->supernodal = v;
+        if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "supernodal", v);
     } else if (!strcmp(key, "prefer") && (v == 0.0 || v == 1.0)) s->prefer = (int)v;
     else if (!strcmp(key, "retry_after") && v >= 0.0 && v <= 1e9) {
         s->retry_after = (int)v;
@@ -201,6 +205,7 @@ static int handle(auto_state *s, int b, odhs_solver **out)
         odhs_solver_set_check_tolerance(s->h[b], s->check_tol);
         if (s->tol > 0.0 && (b == B_CG || b == B_CHOLMOD_PCG)) odhs_solver_set_param(s->h[b], "tol", s->tol);
         if (b == B_CHOLMOD_PCG && s->update_max != 0.125) odhs_solver_set_param(s->h[b], "update_max", s->update_max);
+        if (b == B_CHOLMOD_PCG && s->supernodal != 0.0) odhs_solver_set_param(s->h[b], "supernodal", s->supernodal);
     }
     *out = s->h[b];
     return ODHS_OK;

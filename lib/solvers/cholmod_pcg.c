@@ -52,11 +52,16 @@
  *   Parameters: "tol" (relative residual, default 1e-12), "maxiter" (default
  *   0 = 10*Nc + 100), "min_rcond" (1e-14), "refactor_every" (50),
  *   "refactor_iterations" (40), "update_max" (0.125, in [0, 1]; since
- *   0.2.14), "supernodal" (only 0 is accepted: the Modify
- *   module needs a simplicial LDL' factor). Statistics: "iterations" (of the
+ *   0.2.14), "supernodal" (0, the default: full factorisations
+ *   by the simplicial LDL' the Modify module needs; since 0.2.20 also 1:
+ *   by supernodes, LL' in dense blocks, converted to that LDL' by
+ *   cholmod_change_factor (packed, O(nnz(L))); -1: CHOLMOD's choice, by
+ *   supernodes where its analysis predicts at least 40 flops per entry of
+ *   L). Statistics: "iterations" (of the
  *   last solve), "updates" (rowadd + rowdel calls), "packs" (the factor's
  *   columns packed to reclaim the holes that moved columns leave; since
- *   0.2.19), "factorizations",
+ *   0.2.19), "supernodal" (1 when the last full factorisation went by
+ *   supernodes; since 0.2.20), "factorizations",
  *   "analyses", "rcond" (of the last full factorisation), "nnz_L" (current),
  *   "flops", "capacity" (slots), "cholmod_status".
  *
@@ -83,6 +88,7 @@ typedef struct {
     cholmod_common c;
     cholmod_sparse *A;        /* [S | E] of the last full factorisation */
     cholmod_factor *L;        /* simplicial LDL' of the slot matrix M */
+    cholmod_factor *Ls;       /* supernodal symbolic analysis, or NULL (simplicial route) */
     cholmod_sparse *R;        /* cap x 1: new row for rowadd */
     cholmod_dense *work[4]; /* cholmod_solve2: B (right-hand side), X (solution), Y, E */
     size_t cap;               /* slots = dimension of L */
@@ -113,8 +119,10 @@ typedef struct {
     double nzmax_packed;      /* the allocation when L was last packed */
     /* parameters */
     double tol, maxiter, min_rcond, refactor_every, refactor_iterations, update_max;
+    int supernodal;           /* 0 simplicial (default), 1 supernodal, -1 CHOLMOD's choice */
     /* statistics */
     double iterations, updates, factorizations, analyses, rcond, status, packs;
+    double super_last;        /* the last full factorisation was supernodal */
 } pcg_state;
 
 /* past PCG_NZMAX_GROWTH times the fresh factor's allocation the factor is
@@ -143,6 +151,7 @@ static void pcg_destroy(void *state)
 {
     pcg_state *s = state;
     if (!s) return;
+    cholmod_free_factor(&s->Ls, &s->c);
     odhs__cm_release(&s->c, &s->L, &s->A, s->work);
     cholmod_free_sparse(&s->R, &s->c);
     odhs__free(s->si);
@@ -170,7 +179,13 @@ static int pcg_set_param(void *state, const char *key, double v)
     else if (!strcmp(key, "refactor_every") && v >= 0.0) s->refactor_every = floor(v);
     else if (!strcmp(key, "refactor_iterations") && v >= 1.0) s->refactor_iterations = floor(v);
     else if (!strcmp(key, "update_max") && v >= 0.0 && v <= 1.0) s->update_max = v;
-    else if (!strcmp(key, "supernodal") && v == 0.0) { /* simplicial only */
+    else if (!strcmp(key, "supernodal") && (v == -1.0 || v == 0.0 || v == 1.0)) {
+        if ((int)v != s->supernodal) { /* a new analysis at the next setup */
+            s->supernodal = (int)v;
+            s->valid = 0;
+            cholmod_free_factor(&s->Ls, &s->c);
+            cholmod_free_factor(&s->L, &s->c);
+        }
     } else return ODHS_E_INVALID;
     return ODHS_OK;
 }
@@ -187,6 +202,7 @@ static int pcg_get_stat(void *state, const char *key, double *v)
     else if (!strcmp(key, "nnz_L")) *v = odhs__cm_factor_nnz(s->L, &s->c);
     else if (!strcmp(key, "flops")) *v = s->L ? s->c.fl : 0.0;
     else if (!strcmp(key, "capacity")) *v = (double)s->cap;
+    else if (!strcmp(key, "supernodal")) *v = s->super_last;
     else if (!strcmp(key, "cholmod_status")) *v = s->status;
     else if (!strcmp(key, "tol")) *v = s->tol;
     else if (!strcmp(key, "update_max")) *v = s->update_max;
@@ -234,7 +250,7 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
         (st = odhs__reserve((void **)&s->lnrm, &s->lnrmcap, cap * (size_t)net->dim, sizeof *s->lnrm)))
         return st;
 
-    int numeric_only = s->L && s->updates_since_analysis == 0 && s->cap == cap && s->n == n &&
+    int numeric_only = (s->L || s->Ls) && s->updates_since_analysis == 0 && s->cap == cap && s->n == n &&
                        s->dim == net->dim;
     for (size_t c = 0; numeric_only && c < nc; ++c)
         if (s->si[c] != net->ci[c] || s->sj[c] != net->cj[c]) numeric_only = 0;
@@ -243,12 +259,20 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
     odhs__cm_fill_S(net, extra, s->A, s->cnt);
     if (!numeric_only) {
         cholmod_free_factor(&s->L, &s->c);
+        cholmod_free_factor(&s->Ls, &s->c);
+        s->c.supernodal = s->supernodal == 1 ? CHOLMOD_SUPERNODAL
+                          : s->supernodal == -1 ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
         s->L = cholmod_analyze(s->A, &s->c);
+        s->c.supernodal = CHOLMOD_SIMPLICIAL;
         s->status = s->c.status;
         if (!s->L) return odhs__cm_error(&s->c);
+        if (s->L->is_super) { /* kept: each full factorisation starts from a copy */
+            s->Ls = s->L;
+            s->L = NULL;
+        }
         s->analyses += 1.0;
         s->updates_since_analysis = 0;
-        const int *perm = s->L->Perm;
+        const int *perm = (s->Ls ? s->Ls : s->L)->Perm;
         for (size_t k = 0; k < cap; ++k) s->pinv[perm[k]] = (int)k;
         /* slots: contacts in network order, the rest free */
         s->cap = cap;
@@ -268,14 +292,31 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
     memcpy(s->snrm, net->nrm, nc * (size_t)net->dim * sizeof *s->snrm);
     memcpy(s->lnrm, net->nrm, nc * (size_t)net->dim * sizeof *s->lnrm);
     s->nc = nc;
+    if (s->Ls) { /* the supernodal route: a fresh copy of the analysis */
+        cholmod_free_factor(&s->L, &s->c);
+        if (!(s->L = cholmod_copy_factor(s->Ls, &s->c))) return odhs__cm_error(&s->c);
+    }
     int ok = cholmod_factorize(s->A, s->L, &s->c);
     s->status = s->c.status;
     s->factorizations += 1.0;
+    s->super_last = s->Ls ? 1.0 : 0.0;
     s->since = 0;
     if (!ok || s->c.status < 0) {
         st = odhs__cm_error(&s->c);
         cholmod_free_factor(&s->L, &s->c);
         return st;
+    }
+    if (s->L->is_super && s->c.status == CHOLMOD_OK && s->L->minor == s->L->n) {
+        /* LL' by supernodes (dense blocks: several times faster where the
+         * analysis predicts many flops per entry of L, as in 3D) into the
+         * simplicial LDL' that the Modify module updates, packed: O(nnz(L)) */
+        ok = cholmod_change_factor(CHOLMOD_REAL, 0, 0, 1, 1, s->L, &s->c);
+        s->status = s->c.status;
+        if (!ok || s->c.status < 0) {
+            st = odhs__cm_error(&s->c);
+            cholmod_free_factor(&s->L, &s->c);
+            return st;
+        }
     }
     if ((st = odhs__cm_check_factor(s->L, &s->c, s->min_rcond, &s->rcond))) return st;
     if (s->L->is_super || s->L->is_ll) return ODHS_E_INTERNAL; /* Modify needs LDL' */
