@@ -91,7 +91,8 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
  *  "refactor_every", "refactor_iterations", "update_max", "supernodal"
  *  (0, the default: full factorisations by the simplicial LDL' itself; since
  *  0.2.20 also 1: by supernodes (LL' in dense blocks, converted to LDL'),
- *  faster on 3D networks (docs/performance.md), and -1: CHOLMOD's choice, by
+ *  faster on 3D networks, slower on 2D ones (docs/performance.md), and -1:
+ *  CHOLMOD's choice, by
  *  supernodes where its analysis predicts at least 40 flops per entry of
  *  L). Statistics: "iterations", "updates", "packs" (since 0.2.19),
  *  "supernodal" (since 0.2.20: 1 when the last full factorisation went by
