@@ -119,7 +119,6 @@ typedef struct {
     double nzmax_packed;      /* the allocation when L was last packed */
     /* parameters */
     double tol, maxiter, min_rcond, refactor_every, refactor_iterations, update_max;
-    int supernodal;           /* 0 simplicial (default), 1 supernodal, -1 CHOLMOD's choice */
     /* statistics */
     double iterations, updates, factorizations, analyses, rcond, status, packs;
     double super_last;        /* the last full factorisation was supernodal */
@@ -136,7 +135,9 @@ static int pcg_create(void **state)
     pcg_state *s = odhs__calloc(1, sizeof *s);
     if (!s) return ODHS_E_NOMEM;
     odhs__cm_start(&s->c);
-    s->c.supernodal = CHOLMOD_SIMPLICIAL; /* the Modify module needs LDL' */
+    /* the route of the full factorisations ("supernodal"): the Modify module
+     * needs a simplicial LDL', which a supernodal LL' is converted to */
+    s->c.supernodal = CHOLMOD_SIMPLICIAL;
     s->c.final_ll = 0;
     s->tol = 1e-12;
     s->min_rcond = 1e-14;
@@ -180,8 +181,9 @@ static int pcg_set_param(void *state, const char *key, double v)
     else if (!strcmp(key, "refactor_iterations") && v >= 1.0) s->refactor_iterations = floor(v);
     else if (!strcmp(key, "update_max") && v >= 0.0 && v <= 1.0) s->update_max = v;
     else if (!strcmp(key, "supernodal") && (v == -1.0 || v == 0.0 || v == 1.0)) {
-        if ((int)v != s->supernodal) { /* a new analysis at the next setup */
-            s->supernodal = (int)v;
+        int mode = v == 1.0 ? CHOLMOD_SUPERNODAL : v == -1.0 ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
+        if (mode != s->c.supernodal) { /* a new analysis at the next setup */
+            s->c.supernodal = mode;
             s->valid = 0;
             cholmod_free_factor(&s->Ls, &s->c);
             cholmod_free_factor(&s->L, &s->c);
@@ -260,10 +262,7 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
     if (!numeric_only) {
         cholmod_free_factor(&s->L, &s->c);
         cholmod_free_factor(&s->Ls, &s->c);
-        s->c.supernodal = s->supernodal == 1 ? CHOLMOD_SUPERNODAL
-                          : s->supernodal == -1 ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
         s->L = cholmod_analyze(s->A, &s->c);
-        s->c.supernodal = CHOLMOD_SIMPLICIAL;
         s->status = s->c.status;
         if (!s->L) return odhs__cm_error(&s->c);
         if (s->L->is_super) { /* kept: each full factorisation starts from a copy */
@@ -297,6 +296,12 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
         if (!(s->L = cholmod_copy_factor(s->Ls, &s->c))) return odhs__cm_error(&s->c);
     }
     int ok = cholmod_factorize(s->A, s->L, &s->c);
+    if (ok && s->L->is_super && s->c.status == CHOLMOD_OK && s->L->minor == s->L->n)
+        /* LL' by supernodes (dense blocks: faster in 3D, slower in 2D, see
+         * docs/performance.md) into the simplicial LDL' that the Modify
+         * module updates, packed: O(nnz(L)). A failed factorisation is not
+         * converted: the check below reports it. */
+        ok = cholmod_change_factor(CHOLMOD_REAL, 0, 0, 1, 1, s->L, &s->c);
     s->status = s->c.status;
     s->factorizations += 1.0;
     s->super_last = s->Ls ? 1.0 : 0.0;
@@ -305,18 +310,6 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
         st = odhs__cm_error(&s->c);
         cholmod_free_factor(&s->L, &s->c);
         return st;
-    }
-    if (s->L->is_super && s->c.status == CHOLMOD_OK && s->L->minor == s->L->n) {
-        /* LL' by supernodes (dense blocks: several times faster where the
-         * analysis predicts many flops per entry of L, as in 3D) into the
-         * simplicial LDL' that the Modify module updates, packed: O(nnz(L)) */
-        ok = cholmod_change_factor(CHOLMOD_REAL, 0, 0, 1, 1, s->L, &s->c);
-        s->status = s->c.status;
-        if (!ok || s->c.status < 0) {
-            st = odhs__cm_error(&s->c);
-            cholmod_free_factor(&s->L, &s->c);
-            return st;
-        }
     }
     if ((st = odhs__cm_check_factor(s->L, &s->c, s->min_rcond, &s->rcond))) return st;
     if (s->L->is_super || s->L->is_ll) return ODHS_E_INTERNAL; /* Modify needs LDL' */
