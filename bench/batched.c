@@ -19,7 +19,11 @@
  *              steps set by the tolerance), over strain 0.3
  *   tight      the same at tol 1e-4 (ODHS_BENCH_TIGHT_TOL: another)
  * ODHS_BENCH_SUPERNODAL=-1|0|1 sets the "supernodal" parameter of auto's
- * cholmod-pcg (0.2.20; 0, the default, is the simplicial route).
+ * cholmod-pcg (0.2.20; 0 is the simplicial route; -1, by supernodes from
+ * "supernodal_switch" flops per entry of L, the default since 0.2.21),
+ * ODHS_BENCH_SUPERNODAL_SWITCH=X that switch (default 200) and
+ * ODHS_BENCH_OPENMP=0|1 auto's "openmp" (0.2.21; 1: CHOLMOD's own threads
+ * in supernodal factorisations, 0 the calling thread alone, the default).
  * Cost per unit strain = CPU seconds of the process / strain. Fitted
  * exponents (least squares of log cost on log N) and an SVG plot.
  *
@@ -78,12 +82,16 @@
 
 enum { S_EXACT, S_BATCHED, S_TIGHT, S_COUNT };
 /* ODHS_BENCH_SUPERNODAL: the "supernodal" parameter of auto's cholmod-pcg
- * (-1, 0 = the default, 1) for the shear and compression runs */
-static double pcg_supernodal;
+ * (-1 = the default since 0.2.21, 0, 1) for the shear and compression runs;
+ * ODHS_BENCH_SUPERNODAL_SWITCH and ODHS_BENCH_OPENMP: "supernodal_switch"
+ * (negative: the default) and "openmp" */
+static double pcg_supernodal = -1.0, pcg_switch = -1.0, cm_openmp = 0.0;
 static int auto_solver(odhs_solver **sol)
 {
     int rc = odhs_solver_create_by_name("auto", sol);
-    if (!rc && pcg_supernodal != 0.0) rc = odhs_solver_set_param(*sol, "supernodal", pcg_supernodal);
+    if (!rc && pcg_supernodal != -1.0) rc = odhs_solver_set_param(*sol, "supernodal", pcg_supernodal);
+    if (!rc && pcg_switch >= 0.0) rc = odhs_solver_set_param(*sol, "supernodal_switch", pcg_switch);
+    if (!rc && cm_openmp != 0.0) rc = odhs_solver_set_param(*sol, "openmp", cm_openmp);
     return rc;
 }
 /* strain of the scan's warm-up (batched): ODHS_BENCH_WARMUP, default 0.3.
@@ -724,15 +732,18 @@ static int from_file(const char *path, double w, const char *setting)
     odhs_solver_get_stat(sol, "fallbacks", &fails);
     odhs_solver_get_stat(sol, "fallback_solves", &fb);
     odhs_solver_get_stat(sol, "rank_deficient", &rdef);
+    double fl = NAN, lnz = NAN;
+    odhs_solver_get_stat(sol, "flops", &fl);
+    odhs_solver_get_stat(sol, "lnz", &lnz);
     if (!rc) odhs_stepper_shear_stress(st, &sxy);
     printf("# libodhs %s, %s, N = %zu, strain %g from %s (status %d%s%s)\n", odhs_version_string(), sname[s],
            odhs_system_count(sys), w, path, rc, rc ? ": " : "", rc ? odhs_stepper_errmsg(st) : "");
     printf("cpu_s %.2f reset_s %.2f steps %llu exact_steps %llu collisions %llu openings %llu contact_problem_solves %llu "
            "corrections %llu correction_passes %llu correction_closed %llu factorizations %.0f analyses %.0f "
-           "failed_attempts %.0f fallback_solves %.0f rank_deficient_solves %.0f sxy_end %.6f\n",
+           "failed_attempts %.0f fallback_solves %.0f rank_deficient_solves %.0f sxy_end %.6f flops_per_lnz %.1f\n",
            cpu, cr, (unsigned long long)steps, (unsigned long long)esteps, (unsigned long long)col, (unsigned long long)op,
            (unsigned long long)bsol, (unsigned long long)corr, (unsigned long long)passes, (unsigned long long)closed,
-           fact, analyses, fails, fb, rdef, sxy);
+           fact, analyses, fails, fb, rdef, sxy, fl / lnz);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);
@@ -1240,6 +1251,22 @@ int main(int argc, char **argv)
         pcg_supernodal = atof(sn);
         if (pcg_supernodal != -1.0 && pcg_supernodal != 0.0 && pcg_supernodal != 1.0) {
             fprintf(stderr, "batched: ODHS_BENCH_SUPERNODAL must be -1, 0 or 1\n");
+            return 2;
+        }
+    }
+    const char *sw = getenv("ODHS_BENCH_SUPERNODAL_SWITCH");
+    if (sw) {
+        pcg_switch = atof(sw);
+        if (!(pcg_switch >= 0.0)) {
+            fprintf(stderr, "batched: ODHS_BENCH_SUPERNODAL_SWITCH must be >= 0\n");
+            return 2;
+        }
+    }
+    const char *om = getenv("ODHS_BENCH_OPENMP");
+    if (om) {
+        cm_openmp = atof(om);
+        if (cm_openmp != 0.0 && cm_openmp != 1.0) {
+            fprintf(stderr, "batched: ODHS_BENCH_OPENMP must be 0 or 1\n");
             return 2;
         }
     }

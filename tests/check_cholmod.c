@@ -1138,6 +1138,158 @@ START_TEST(test_pcg_supernodal)
 }
 END_TEST
 
+/* The default route since 0.2.21: "supernodal" = -1 goes by supernodes
+ * exactly when the analysis predicts at least "supernodal_switch" (200)
+ * flops per entry of L, and a new switch takes effect at the next solve with
+ * the same answer. "openmp" (0, the default: CHOLMOD's OpenMP loops on the
+ * calling thread) does not change a bit of the result, and the calling
+ * thread's OpenMP setting is as it was after the solve. */
+#if defined(__GNUC__) && defined(__ELF__)
+extern int omp_get_max_active_levels(void) __attribute__((weak));
+extern void omp_set_max_active_levels(int) __attribute__((weak));
+#endif
+/* threads of this process (Linux), -1 where unknown */
+static long cm_threads(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    if (!f) return -1;
+    char line[256];
+    long t = -1;
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, "Threads:", 8)) {
+            t = strtol(line + 8, NULL, 10);
+            break;
+        }
+    fclose(f);
+    return t;
+}
+START_TEST(test_pcg_supernodal_switch)
+{
+    /* two copies of one network: a solve on the other copy makes the solver
+     * set up again, where a new route takes effect */
+    odhs_network *net = NULL, *net2 = NULL;
+    odhs_system *sys = cm_scene(3, 300, 0.62, 9, &net), *sys2 = cm_scene(3, 300, 0.62, 9, &net2);
+    ck_assert_uint_eq(odhs_network_count(net2), odhs_network_count(net));
+    size_t nc = odhs_network_count(net);
+    tu_rng rng;
+    tu_rng_seed(&rng, 11);
+    double *b = malloc(nc * sizeof *b), *x[4];
+    ck_assert(b);
+    for (int k = 0; k < 4; ++k) ck_assert((x[k] = calloc(nc, sizeof *x[k])) != NULL);
+    cm_rhs(net, &rng, b);
+    odhs_solver *p = cm_new(&odhs_solver_type_cholmod_pcg);
+    ck_assert_double_eq(cm_stat(p, "supernodal_switch"), 200.0);
+    ck_assert_double_eq(cm_stat(p, "openmp"), 0.0);
+    ck_assert_int_eq(odhs_solver_solve(p, net, b, x[0]), ODHS_OK);
+    double ratio = cm_stat(p, "flops") / cm_stat(p, "lnz");
+    cm_note("pcg default route, 3D packing N = 300, Nc = %zu: %.1f flops per entry of L, supernodal %g", nc, ratio,
+            cm_stat(p, "supernodal"));
+    ck_assert(ratio > 10.0 && ratio < 200.0);
+    ck_assert_double_eq(cm_stat(p, "supernodal"), 0.0); /* below the switch */
+    /* a switch below this network's ratio: a new analysis, by supernodes */
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal_switch", 0.5 * ratio), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_solve(p, net, b, x[1]), ODHS_OK); /* the same network: the factor serves */
+    ck_assert_double_eq(cm_stat(p, "supernodal"), 0.0);
+    ck_assert_double_eq(cm_stat(p, "analyses"), 1.0);
+    long t0 = cm_threads();
+    ck_assert_int_eq(odhs_solver_solve(p, net2, b, x[1]), ODHS_OK);
+    ck_assert_double_eq(cm_stat(p, "supernodal"), 1.0);
+    long t1 = cm_threads(); /* "openmp" 0: CHOLMOD started no thread */
+    ck_assert_msg(t1 == t0, "threads %ld -> %ld in a supernodal factorisation with openmp 0", t0, t1);
+    ck_assert_double_eq(cm_stat(p, "analyses"), 2.0);
+    ck_assert_msg(cm_reldiff(nc, x[0], x[1]) < 1e-10, "switch: %g", cm_reldiff(nc, x[0], x[1]));
+    /* CHOLMOD's threads give the same bits */
+    ck_assert_int_eq(odhs_solver_set_param(p, "openmp", 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal_switch", 0.4 * ratio), ODHS_OK); /* analyse again */
+    double f0 = cm_stat(p, "factorizations");
+    ck_assert_int_eq(odhs_solver_solve(p, net, b, x[2]), ODHS_OK);
+    ck_assert_double_eq(cm_stat(p, "factorizations"), f0 + 1.0);
+    ck_assert_double_eq(cm_stat(p, "supernodal"), 1.0);
+    /* CHOLMOD's threads (Debian's OpenMP build: 4 per parallel loop) start
+     * only now: every supernodal factorisation before this one, the scenes'
+     * compressions included, ran with the default "openmp" 0 on the
+     * calling thread. Asserted where the process has an OpenMP runtime and
+     * no OMP_THREAD_LIMIT. */
+    long t2 = cm_threads();
+    cm_note("threads: %ld before, %ld after a supernodal factorisation with openmp 0, %ld after one with openmp 1",
+            t0, t1, t2);
+#if defined(__GNUC__) && defined(__ELF__)
+    if (omp_get_max_active_levels && !getenv("OMP_THREAD_LIMIT") && t1 > 0)
+        ck_assert_msg(t2 > t1, "openmp 1 started no thread (%ld -> %ld): were CHOLMOD's threads on before?", t1, t2);
+    else
+        cm_note("threads with openmp 1 not checked (no OpenMP runtime bound, or OMP_THREAD_LIMIT set)");
+#endif
+    f0 = cm_stat(p, "factorizations");
+    ck_assert_int_eq(odhs_solver_set_param(p, "openmp", 0.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal_switch", 0.3 * ratio), ODHS_OK);
+#if defined(__GNUC__) && defined(__ELF__)
+    int levels = -1;
+    if (omp_get_max_active_levels && omp_set_max_active_levels) {
+        levels = omp_get_max_active_levels();
+        omp_set_max_active_levels(3);
+    }
+#endif
+    ck_assert_int_eq(odhs_solver_solve(p, net2, b, x[3]), ODHS_OK);
+#if defined(__GNUC__) && defined(__ELF__)
+    if (levels >= 0) {
+        ck_assert_int_eq(omp_get_max_active_levels(), 3); /* restored after the factorisation */
+        omp_set_max_active_levels(levels);
+    }
+#endif
+    ck_assert_double_eq(cm_stat(p, "factorizations"), f0 + 1.0);
+    ck_assert_double_eq(cm_stat(p, "supernodal"), 1.0);
+    ck_assert(!memcmp(x[2], x[3], nc * sizeof *x[2]));
+    /* back above the ratio: simplicial again */
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal_switch", 1e300), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_solve(p, net, b, x[1]), ODHS_OK);
+    ck_assert_double_eq(cm_stat(p, "analyses"), 5.0);
+    ck_assert_double_eq(cm_stat(p, "supernodal"), 0.0);
+    ck_assert_msg(cm_reldiff(nc, x[0], x[1]) < 1e-10, "switch back: %g", cm_reldiff(nc, x[0], x[1]));
+    /* bad values are refused and leave the old ones */
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal_switch", -1.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "supernodal_switch", NAN), ODHS_E_NONFINITE);
+    ck_assert_int_eq(odhs_solver_set_param(p, "openmp", 0.5), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "openmp", 2.0), ODHS_E_INVALID);
+    ck_assert_double_eq(cm_stat(p, "supernodal_switch"), 1e300);
+    ck_assert_double_eq(cm_stat(p, "openmp"), 0.0);
+    odhs_solver_destroy(p);
+    /* through auto, which hands both on; and the direct backend's "openmp" */
+    odhs_solver *a = cm_by_name("auto");
+    ck_assert_int_eq(odhs_solver_set_param(a, "supernodal_switch", 0.5 * ratio), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(a, "openmp", 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(a, "supernodal_switch", -2.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(a, "openmp", 3.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_solve(a, net, b, x[2]), ODHS_OK);
+    ck_assert_double_eq(cm_stat(a, "supernodal"), 1.0);
+    ck_assert_double_eq(cm_stat(a, "openmp"), 1.0);
+    ck_assert_msg(cm_reldiff(nc, x[0], x[2]) < 1e-10, "auto: %g", cm_reldiff(nc, x[0], x[2]));
+    /* and to the backend it already has */
+    ck_assert_int_eq(odhs_solver_set_param(a, "openmp", 0.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(a, "supernodal_switch", 1e300), ODHS_OK);
+    ck_assert_double_eq(cm_stat(a, "openmp"), 0.0);
+    ck_assert_double_eq(cm_stat(a, "supernodal_switch"), 1e300);
+    odhs_solver_destroy(a);
+    odhs_solver *d = cm_new(&odhs_solver_type_cholmod);
+    ck_assert_double_eq(cm_stat(d, "openmp"), 0.0);
+    ck_assert_int_eq(odhs_solver_set_param(d, "supernodal", 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_solve(d, net, b, x[2]), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(d, "openmp", 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(d, "openmp", -1.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_solve(d, net2, b, x[3]), ODHS_OK); /* a new factorisation, same pattern */
+    ck_assert_double_eq(cm_stat(d, "factorizations"), 2.0);
+    ck_assert_double_eq(cm_stat(d, "supernodal"), 1.0);
+    ck_assert(!memcmp(x[2], x[3], nc * sizeof *x[2]));
+    ck_assert_msg(cm_reldiff(nc, x[0], x[3]) < 1e-10, "cholmod: %g", cm_reldiff(nc, x[0], x[3]));
+    odhs_solver_destroy(d);
+    for (int k = 0; k < 4; ++k) free(x[k]);
+    free(b);
+    odhs_network_destroy(net);
+    odhs_system_destroy(sys);
+    odhs_network_destroy(net2);
+    odhs_system_destroy(sys2);
+}
+END_TEST
+
 /* A shear run's events at N = 512: each new contact enters the factor in a
  * free slot, and a column of L that outgrows its room moves to the end of the
  * factor and leaves a hole, so the allocation outgrows PCG_NZMAX_GROWTH (2.5)
@@ -1229,6 +1381,7 @@ Suite *make_cholmod_suite(void)
     tcase_add_test(tc, test_pcg_capacity);
     tcase_add_test(tc, test_pcg_bulk_insertions);
     tcase_add_test(tc, test_pcg_supernodal);
+    tcase_add_test(tc, test_pcg_supernodal_switch);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("stepper");

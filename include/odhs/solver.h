@@ -72,8 +72,16 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cg;
  *  non-positive pivot or a reciprocal condition estimate (cholmod_rcond)
  *  below "min_rcond" (default 1e-14) gives ODHS_E_SINGULAR. Parameters:
  *  "min_rcond", "supernodal" (0 simplicial, 1 supernodal, -1 automatic,
- *  the default). Statistics: "analyses", "factorizations", "rcond",
- *  "nnz_L", "flops", "cholmod_status". */
+ *  the default), "openmp" (since 0.2.21; 0, the default: the OpenMP loops
+ *  of CHOLMOD's supernodal factorisation run on the calling thread alone;
+ *  1: on CHOLMOD's own threads, which Debian's build asks for 4 of per
+ *  loop; the result is the same to the bit; the library reaches the OpenMP
+ *  runtime that CHOLMOD loaded through weak references, so in a fully
+ *  static link without them, or with a runtime older than GCC 11's libgomp
+ *  (whose setting is per process, unsafe with solves in several threads),
+ *  set OMP_THREAD_LIMIT=1 instead). Statistics: "analyses",
+ *  "factorizations", "rcond", "nnz_L", "flops", "cholmod_status",
+ *  "supernodal", "openmp". */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
 /** CHOLMOD factor as a preconditioner for CG ("cholmod-pcg"): a simplicial
  *  LDL' factor over stable contact slots, updated with CHOLMOD's Modify
@@ -89,15 +97,25 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
  *  unchanged, e.g. during rewiring.
  *  Parameters: "tol" (default 1e-12), "maxiter", "min_rcond",
  *  "refactor_every", "refactor_iterations", "update_max", "supernodal"
- *  (0, the default: full factorisations by the simplicial LDL' itself; since
- *  0.2.20 also 1: by supernodes (LL' in dense blocks, converted to LDL'),
- *  faster on 3D networks, slower on 2D ones (docs/performance.md), and -1:
- *  CHOLMOD's choice, by
- *  supernodes where its analysis predicts at least 40 flops per entry of
- *  L). Statistics: "iterations", "updates", "packs" (since 0.2.19),
- *  "supernodal" (since 0.2.20: 1 when the last full factorisation went by
- *  supernodes), "factorizations", "analyses", "rcond", "nnz_L",
- *  "capacity". */
+ *  (0: full factorisations by the simplicial LDL' itself, the default up to
+ *  0.2.20; since 0.2.20 also 1: by supernodes (LL' in dense blocks,
+ *  converted to LDL'), and -1: by supernodes where the analysis predicts at
+ *  least "supernodal_switch" flops per entry of L, the default since
+ *  0.2.21), "supernodal_switch" (since 0.2.21, >= 0; default 200: by
+ *  supernodes on 3D networks from about 1000 particles on, where that is
+ *  2-2.5x cheaper for batched steps, simplicial on 2D ones up to N = 65536,
+ *  where supernodes are 1.1-1.9x dearer; 150 also takes 3D networks of
+ *  500-1000 particles, 1.5x cheaper at N = 600; docs/performance.md,
+ *  0.2.21; 0.2.20's -1 used CHOLMOD's switch, 40), "openmp" (since 0.2.21; as for "cholmod").
+ *  A new "supernodal" or "supernodal_switch" takes effect at the next
+ *  full factorisation after an analysis: at the next setup (the next change
+ *  of the network) or a refactorisation inside a solve. Statistics: "iterations",
+ *  "updates", "packs" (since 0.2.19), "supernodal" (since 0.2.20: 1 when
+ *  the last full factorisation went by supernodes), "factorizations",
+ *  "analyses", "rcond", "nnz_L", "flops" and "lnz" (since 0.2.21: the
+ *  flops and the entries of L that the last analysis predicts; their ratio
+ *  decides "supernodal" = -1), "capacity", and the parameters "tol",
+ *  "update_max", "supernodal_switch", "openmp". */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
 /** SuiteSparseQR on A = S^T (only in builds with SuiteSparse; otherwise
  *  "spqr" gives ODHS_E_NOTINSTALLED): solve_ls computes the least-squares
@@ -151,8 +169,9 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
  *  SuiteSparse build choose as a build without it (1 in a build without
  *  gives ODHS_E_NOTINSTALLED). "tol" (since 0.2) is handed to the iterative
  *  backends cg and cholmod-pcg (their relative residual; default theirs,
- *  1e-12); "update_max" (since 0.2.14) and "supernodal" (since 0.2.20) to
- *  cholmod-pcg. Statistics: "backend" and "primary" (codes
+ *  1e-12); "update_max" (since 0.2.14), "supernodal" (since 0.2.20) and
+ *  "supernodal_switch" (since 0.2.21) to cholmod-pcg; "openmp" (since
+ *  0.2.21) to cholmod and cholmod-pcg. Statistics: "backend" and "primary" (codes
  *  0 cg, 1 dense, 2 cholmod, 3 cholmod-pcg, 4 spqr, 5 lsq-svd, 6 lsq-cg,
  *  7 lsq-pcg (since 0.2.16); -1
  *  before the first solve), "fallbacks" (failed attempts followed by another

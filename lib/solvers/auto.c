@@ -85,7 +85,9 @@ typedef struct {
     double dense_max, dense_fallback_max, lsq_dense_max, lsq_rcond, check_tol;
     double tol;           /* "tol" of the iterative backends (cg, cholmod-pcg); 0: their own */
     double update_max;    /* "update_max" of cholmod-pcg */
-    double supernodal;    /* "supernodal" of cholmod-pcg (since 0.2.20) */
+    double supernodal;    /* "supernodal" of cholmod-pcg (since 0.2.20; default -1 since 0.2.21) */
+    double supernodal_switch; /* of cholmod-pcg (since 0.2.21); NAN: the backend's default */
+    double openmp;        /* "openmp" of cholmod and cholmod-pcg (since 0.2.21) */
     int prefer, retry_after, retry_after_lsq;
     /* state */
     int sticky_backend;   /* backend to try first, -1: none */
@@ -115,6 +117,8 @@ static int auto_create(void **state)
     s->retry_after = 20;
     s->retry_after_lsq = 0;
     s->update_max = 0.125;
+    s->supernodal = -1.0;
+    s->supernodal_switch = NAN;
     s->sticky_backend = -1;
     s->last = s->primary = -1;
     *state = s;
@@ -161,6 +165,13 @@ static int auto_set_param(void *state, const char *key, double v)
     } else if (!strcmp(key, "supernodal") && (v == -1.0 || v == 0.0 || v == 1.0)) {
         s->supernodal = v;
         if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "supernodal", v);
+    } else if (!strcmp(key, "supernodal_switch") && v >= 0.0 && v <= 1e300) {
+        s->supernodal_switch = v;
+        if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "supernodal_switch", v);
+    } else if (!strcmp(key, "openmp") && (v == 0.0 || v == 1.0)) {
+        s->openmp = v;
+        if (s->h[B_CHOLMOD]) odhs_solver_set_param(s->h[B_CHOLMOD], "openmp", v);
+        if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "openmp", v);
     } else if (!strcmp(key, "prefer") && (v == 0.0 || v == 1.0)) s->prefer = (int)v;
     else if (!strcmp(key, "retry_after") && v >= 0.0 && v <= 1e9) {
         s->retry_after = (int)v;
@@ -205,7 +216,10 @@ static int handle(auto_state *s, int b, odhs_solver **out)
         odhs_solver_set_check_tolerance(s->h[b], s->check_tol);
         if (s->tol > 0.0 && (b == B_CG || b == B_CHOLMOD_PCG)) odhs_solver_set_param(s->h[b], "tol", s->tol);
         if (b == B_CHOLMOD_PCG && s->update_max != 0.125) odhs_solver_set_param(s->h[b], "update_max", s->update_max);
-        if (b == B_CHOLMOD_PCG && s->supernodal != 0.0) odhs_solver_set_param(s->h[b], "supernodal", s->supernodal);
+        if (b == B_CHOLMOD_PCG && s->supernodal != -1.0) odhs_solver_set_param(s->h[b], "supernodal", s->supernodal);
+        if (b == B_CHOLMOD_PCG && !isnan(s->supernodal_switch))
+            odhs_solver_set_param(s->h[b], "supernodal_switch", s->supernodal_switch);
+        if ((b == B_CHOLMOD || b == B_CHOLMOD_PCG) && s->openmp != 0.0) odhs_solver_set_param(s->h[b], "openmp", s->openmp);
     }
     *out = s->h[b];
     return ODHS_OK;

@@ -19,7 +19,11 @@
  *   estimate (cholmod_rcond) not above "min_rcond" is reported as
  *   ODHS_E_SINGULAR: singular or hyperstatic networks.
  *   Parameters: "min_rcond" (default 1e-14), "supernodal" (0 = simplicial
- *   LDL', 1 = supernodal LL', -1 = CHOLMOD's automatic choice, the default).
+ *   LDL', 1 = supernodal LL', -1 = CHOLMOD's automatic choice, the default),
+ *   "openmp" (since 0.2.21; 0, the default: the OpenMP loops of CHOLMOD's
+ *   supernodal factorisation run on the calling thread alone; 1: they use
+ *   CHOLMOD's own threads, 4 per loop in Debian's build, fewer under
+ *   OMP_THREAD_LIMIT; the same result either way: odhs__cm_factorize).
  *   Statistics: "analyses", "factorizations", "updates" (always 0 here),
  *   "rcond", "nnz_L", "flops" (CHOLMOD's flop count of the factorisation,
  *   from the analysis), "iterations" (0), "cholmod_status" (Common->status
@@ -50,6 +54,7 @@ typedef struct {
     size_t cntcap;
     int factored;
     int supernodal;           /* -1 auto, 0 simplicial, 1 supernodal */
+    int openmp;               /* CHOLMOD's OpenMP threads in supernodal factorisations */
     double min_rcond;
     double rcond, analyses, factorizations, status;
 } chm_state;
@@ -83,7 +88,8 @@ static int chm_set_param(void *state, const char *key, double v)
     else if (!strcmp(key, "supernodal") && (v == -1.0 || v == 0.0 || v == 1.0)) {
         if ((int)v != s->supernodal) s->have_pattern = 0; /* analyse again */
         s->supernodal = (int)v;
-    } else return ODHS_E_INVALID;
+    } else if (!strcmp(key, "openmp") && (v == 0.0 || v == 1.0)) s->openmp = (int)v;
+    else return ODHS_E_INVALID;
     return ODHS_OK;
 }
 
@@ -98,6 +104,7 @@ static int chm_get_stat(void *state, const char *key, double *v)
     else if (!strcmp(key, "flops")) *v = s->L ? s->c.fl : 0.0;
     else if (!strcmp(key, "cholmod_status")) *v = s->status;
     else if (!strcmp(key, "supernodal")) *v = s->L ? (double)s->L->is_super : (double)s->supernodal;
+    else if (!strcmp(key, "openmp")) *v = (double)s->openmp;
     else return ODHS_E_INVALID;
     return ODHS_OK;
 }
@@ -139,7 +146,7 @@ static int chm_setup(void *state, const odhs_network *net)
         s->pdim = net->dim;
         s->have_pattern = 1;
     }
-    int ok = cholmod_factorize(s->A, s->L, &s->c);
+    int ok = odhs__cm_factorize(s->A, NULL, s->L, &s->c, s->openmp);
     s->status = s->c.status;
     s->factorizations += 1.0;
     if (!ok || s->c.status < 0) {

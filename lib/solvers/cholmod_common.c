@@ -151,6 +151,33 @@ double odhs__cm_factor_nnz(const cholmod_factor *L, const cholmod_common *c)
     return s;
 }
 
+/* The OpenMP runtime's calls, bound only when the process has one (CHOLMOD's
+ * libgomp): weak references, so that neither the library nor a program that
+ * links it needs an OpenMP runtime of its own. */
+#if defined(__GNUC__) && defined(__ELF__)
+#define ODHS_WEAK_OMP 1
+extern int omp_get_max_active_levels(void) __attribute__((weak));
+extern void omp_set_max_active_levels(int) __attribute__((weak));
+#endif
+
+int odhs__cm_factorize(cholmod_sparse *A, double *beta, cholmod_factor *L, cholmod_common *c, int openmp)
+{
+    double zero[2] = {0.0, 0.0}; /* cholmod_factorize's beta: CHOLMOD reads it */
+    if (!beta) beta = zero;
+#ifdef ODHS_WEAK_OMP
+    if (!openmp && L && L->is_super && omp_get_max_active_levels && omp_set_max_active_levels) {
+        int levels = omp_get_max_active_levels();
+        omp_set_max_active_levels(0);
+        int ok = cholmod_factorize_p(A, beta, NULL, 0, L, c);
+        omp_set_max_active_levels(levels);
+        return ok;
+    }
+#else
+    (void)openmp;
+#endif
+    return cholmod_factorize_p(A, beta, NULL, 0, L, c);
+}
+
 /* Check a fresh numeric factorisation: ODHS_OK, ODHS_E_SINGULAR or an error. */
 int odhs__cm_check_factor(cholmod_factor *L, cholmod_common *c, double min_rcond, double *rcond)
 {

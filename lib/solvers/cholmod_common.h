@@ -47,6 +47,20 @@ void odhs__cm_fill_S(const odhs_network *net, size_t nextra, cholmod_sparse *A, 
 int odhs__cm_simplicial_pivots(const cholmod_factor *L, double *dmin, double *dmax);
 /* Number of stored entries of L. */
 double odhs__cm_factor_nnz(const cholmod_factor *L, const cholmod_common *c);
+/* cholmod_factorize_p(A, beta, NULL, 0, L, c) (beta NULL: zero). The
+ * supernodal factorisation of CHOLMOD 3 (SuiteSparse 5) runs some loops of
+ * every supernode as OpenMP parallel regions that ask for a fixed 4 threads;
+ * unless openmp is nonzero they run on the calling thread alone: the OpenMP
+ * ICV max-active-levels of the calling thread (a per-thread setting in
+ * OpenMP 5.1 and libgomp since GCC 11) is set to 0 for the call and then
+ * restored. The loops only fill and clear the factor's entries, so the
+ * result does not depend on the thread count. Without an OpenMP runtime in
+ * the process (a CHOLMOD built without OpenMP) this is cholmod_factorize_p.
+ * The runtime's two calls are weak references: a fully static link that
+ * does not pull them out of libgomp.a leaves them unbound, and CHOLMOD's
+ * threads then run. A runtime older than GCC 11's libgomp keeps the ICV
+ * per process, not per thread. */
+int odhs__cm_factorize(cholmod_sparse *A, double *beta, cholmod_factor *L, cholmod_common *c, int openmp);
 /* Check a fresh numeric factorisation: ODHS_OK, ODHS_E_SINGULAR or an error. */
 int odhs__cm_check_factor(cholmod_factor *L, cholmod_common *c, double min_rcond, double *rcond);
 

@@ -52,18 +52,26 @@
  *   Parameters: "tol" (relative residual, default 1e-12), "maxiter" (default
  *   0 = 10*Nc + 100), "min_rcond" (1e-14), "refactor_every" (50),
  *   "refactor_iterations" (40), "update_max" (0.125, in [0, 1]; since
- *   0.2.14), "supernodal" (0, the default: full factorisations
- *   by the simplicial LDL' the Modify module needs; since 0.2.20 also 1:
+ *   0.2.14), "supernodal" (0: full factorisations by the simplicial LDL'
+ *   the Modify module needs, the default up to 0.2.20; since 0.2.20 also 1:
  *   by supernodes, LL' in dense blocks, converted to that LDL' by
- *   cholmod_change_factor (packed, O(nnz(L))); -1: CHOLMOD's choice, by
- *   supernodes where its analysis predicts at least 40 flops per entry of
- *   L). Statistics: "iterations" (of the
+ *   cholmod_change_factor (packed, O(nnz(L))); -1: by supernodes where the
+ *   analysis predicts at least "supernodal_switch" flops per entry of L,
+ *   CHOLMOD_AUTO; the default since 0.2.21), "supernodal_switch" (since
+ *   0.2.21; default 200, measured: PCG_SUPERNODAL_SWITCH; CHOLMOD's own is
+ *   40, which 0.2.20's -1 used), "openmp" (since 0.2.21; 0, the default:
+ *   the OpenMP loops of CHOLMOD's supernodal factorisation run on the
+ *   calling thread; 1: on CHOLMOD's own threads; the same result:
+ *   odhs__cm_factorize). Statistics: "iterations" (of the
  *   last solve), "updates" (rowadd + rowdel calls), "packs" (the factor's
  *   columns packed to reclaim the holes that moved columns leave; since
  *   0.2.19), "supernodal" (1 when the last full factorisation went by
  *   supernodes; since 0.2.20), "factorizations",
  *   "analyses", "rcond" (of the last full factorisation), "nnz_L" (current),
- *   "flops", "capacity" (slots), "cholmod_status".
+ *   "flops" and "lnz" (since 0.2.21: the flops and entries of L that the
+ *   last analysis predicts; their ratio decides "supernodal" = -1),
+ *   "capacity" (slots), "cholmod_status", and the parameters "tol",
+ *   "update_max", "supernodal_switch", "openmp".
  *
  * As for both backends (cholmod_common.h): each state owns its own
  * cholmod_common, CHOLMOD never prints, and its int interface is used.
@@ -122,11 +130,25 @@ typedef struct {
     /* statistics */
     double iterations, updates, factorizations, analyses, rcond, status, packs;
     double super_last;        /* the last full factorisation was supernodal */
+    int openmp;               /* CHOLMOD's OpenMP threads in supernodal factorisations */
+    int reanalyse;            /* the route changed ("supernodal", "supernodal_switch"): the
+                               * current factor serves until the next setup, which
+                               * analyses and factorises afresh */
 } pcg_state;
 
 /* past PCG_NZMAX_GROWTH times the fresh factor's allocation the factor is
  * packed (pcg_reclaim); insertions stop (and setup refactors) past
  * PCG_NZMAX_HARD times, or when the fill has doubled */
+/* "supernodal_switch": the flops per entry of L from which the full
+ * factorisations go by supernodes under "supernodal" = -1 (the default since
+ * 0.2.21). Measured with batched shear (docs/performance.md, 0.2.21), CPU
+ * time by supernodes over simplicial: 1.9x at 53 (2D N = 4096), 1.4x at 100
+ * (2D N = 16384), 1.12x at 192 (2D N = 65536, tiled), 1.05-1.4x at 90 (3D
+ * N = 300); 0.6x at 165 (3D N = 600), 0.5x at 220 (3D N = 1000), 0.4x at
+ * 410 (3D N = 2000). 200 keeps every measured 2D network simplicial, at the
+ * price of 3D networks between about 500 and 900 particles. CHOLMOD's own
+ * switch is 40. */
+#define PCG_SUPERNODAL_SWITCH 200.0
 #define PCG_NZMAX_GROWTH 2.5
 #define PCG_NZMAX_HARD 4.0
 
@@ -137,7 +159,8 @@ static int pcg_create(void **state)
     odhs__cm_start(&s->c);
     /* the route of the full factorisations ("supernodal"): the Modify module
      * needs a simplicial LDL', which a supernodal LL' is converted to */
-    s->c.supernodal = CHOLMOD_SIMPLICIAL;
+    s->c.supernodal = CHOLMOD_AUTO;
+    s->c.supernodal_switch = PCG_SUPERNODAL_SWITCH;
     s->c.final_ll = 0;
     s->tol = 1e-12;
     s->min_rcond = 1e-14;
@@ -182,13 +205,13 @@ static int pcg_set_param(void *state, const char *key, double v)
     else if (!strcmp(key, "update_max") && v >= 0.0 && v <= 1.0) s->update_max = v;
     else if (!strcmp(key, "supernodal") && (v == -1.0 || v == 0.0 || v == 1.0)) {
         int mode = v == 1.0 ? CHOLMOD_SUPERNODAL : v == -1.0 ? CHOLMOD_AUTO : CHOLMOD_SIMPLICIAL;
-        if (mode != s->c.supernodal) { /* a new analysis at the next setup */
-            s->c.supernodal = mode;
-            s->valid = 0;
-            cholmod_free_factor(&s->Ls, &s->c);
-            cholmod_free_factor(&s->L, &s->c);
-        }
-    } else return ODHS_E_INVALID;
+        if (mode != s->c.supernodal) s->reanalyse = 1;
+        s->c.supernodal = mode;
+    } else if (!strcmp(key, "supernodal_switch") && v >= 0.0 && v <= 1e300) {
+        if (v != s->c.supernodal_switch && s->c.supernodal == CHOLMOD_AUTO) s->reanalyse = 1;
+        s->c.supernodal_switch = v;
+    } else if (!strcmp(key, "openmp") && (v == 0.0 || v == 1.0)) s->openmp = (int)v;
+    else return ODHS_E_INVALID;
     return ODHS_OK;
 }
 
@@ -203,8 +226,11 @@ static int pcg_get_stat(void *state, const char *key, double *v)
     else if (!strcmp(key, "rcond")) *v = s->rcond;
     else if (!strcmp(key, "nnz_L")) *v = odhs__cm_factor_nnz(s->L, &s->c);
     else if (!strcmp(key, "flops")) *v = s->L ? s->c.fl : 0.0;
+    else if (!strcmp(key, "lnz")) *v = s->L ? s->c.lnz : 0.0;
     else if (!strcmp(key, "capacity")) *v = (double)s->cap;
     else if (!strcmp(key, "supernodal")) *v = s->super_last;
+    else if (!strcmp(key, "supernodal_switch")) *v = s->c.supernodal_switch;
+    else if (!strcmp(key, "openmp")) *v = (double)s->openmp;
     else if (!strcmp(key, "cholmod_status")) *v = s->status;
     else if (!strcmp(key, "tol")) *v = s->tol;
     else if (!strcmp(key, "update_max")) *v = s->update_max;
@@ -252,8 +278,8 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
         (st = odhs__reserve((void **)&s->lnrm, &s->lnrmcap, cap * (size_t)net->dim, sizeof *s->lnrm)))
         return st;
 
-    int numeric_only = (s->L || s->Ls) && s->updates_since_analysis == 0 && s->cap == cap && s->n == n &&
-                       s->dim == net->dim;
+    int numeric_only = !s->reanalyse && (s->L || s->Ls) && s->updates_since_analysis == 0 && s->cap == cap &&
+                       s->n == n && s->dim == net->dim;
     for (size_t c = 0; numeric_only && c < nc; ++c)
         if (s->si[c] != net->ci[c] || s->sj[c] != net->cj[c]) numeric_only = 0;
 
@@ -271,6 +297,7 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
         }
         s->analyses += 1.0;
         s->updates_since_analysis = 0;
+        s->reanalyse = 0;
         const int *perm = (s->Ls ? s->Ls : s->L)->Perm;
         for (size_t k = 0; k < cap; ++k) s->pinv[perm[k]] = (int)k;
         /* slots: contacts in network order, the rest free */
@@ -295,7 +322,7 @@ static int pcg_full(pcg_state *s, const odhs_network *net)
         cholmod_free_factor(&s->L, &s->c);
         if (!(s->L = cholmod_copy_factor(s->Ls, &s->c))) return odhs__cm_error(&s->c);
     }
-    int ok = cholmod_factorize(s->A, s->L, &s->c);
+    int ok = odhs__cm_factorize(s->A, NULL, s->L, &s->c, s->openmp);
     if (ok && s->L->is_super && s->c.status == CHOLMOD_OK && s->L->minor == s->L->n)
         /* LL' by supernodes (dense blocks: faster in 3D, slower in 2D, see
          * docs/performance.md) into the simplicial LDL' that the Modify
@@ -531,7 +558,7 @@ static int pcg_setup(void *state, const odhs_network *net)
     pcg_state *s = state;
     size_t nc = net->nc;
     int st;
-    if (!s->valid || !s->L || s->n != net->n || s->dim != net->dim) return pcg_full(s, net);
+    if (s->reanalyse || !s->valid || !s->L || s->n != net->n || s->dim != net->dim) return pcg_full(s, net);
     if ((st = odhs__reserve((void **)&s->c2s, &s->c2scap, nc, sizeof *s->c2s))) return st;
     if ((st = pcg_stamp(s))) return st;
     s->valid = 0; /* c2s is rewritten: until this setup went through */

@@ -115,7 +115,7 @@ static int lp_setup(void *state, const odhs_network *net)
     s->L = cholmod_analyze(s->A, &s->c);
     if (!s->L) return odhs__cm_error(&s->c);
     double beta[2] = {s->shift * dmax, 0.0};
-    int ok = cholmod_factorize_p(s->A, beta, NULL, 0, s->L, &s->c);
+    int ok = odhs__cm_factorize(s->A, beta, s->L, &s->c, 0); /* CHOLMOD on the calling thread */
     s->factorizations += 1.0;
     if (!ok || s->c.status < 0) {
         st = odhs__cm_error(&s->c);
