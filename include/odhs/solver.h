@@ -106,10 +106,11 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
  *  2-2.5x cheaper for batched steps, simplicial on 2D ones up to N = 65536,
  *  where supernodes are 1.1-1.9x dearer; 150 also takes 3D networks of
  *  500-1000 particles, 1.5x cheaper at N = 600; docs/performance.md,
- *  0.2.21; 0.2.20's -1 used CHOLMOD's switch, 40), "openmp" (since 0.2.21; as for "cholmod").
- *  A new "supernodal" or "supernodal_switch" takes effect at the next
- *  full factorisation after an analysis: at the next setup (the next change
- *  of the network) or a refactorisation inside a solve. Statistics: "iterations",
+ *  0.2.21; 0.2.20's -1 used CHOLMOD's switch, 40), "openmp" (since
+ *  0.2.21; as for "cholmod"). A new "supernodal" or "supernodal_switch"
+ *  takes effect at the next full factorisation after an analysis: at the
+ *  next setup (the next change of the network) or a refactorisation inside
+ *  a solve. Statistics: "iterations",
  *  "updates", "packs" (since 0.2.19), "supernodal" (since 0.2.20: 1 when
  *  the last full factorisation went by supernodes), "factorizations",
  *  "analyses", "rcond", "nnz_L", "flops" and "lnz" (since 0.2.21: the

@@ -136,9 +136,6 @@ typedef struct {
                                * analyses and factorises afresh */
 } pcg_state;
 
-/* past PCG_NZMAX_GROWTH times the fresh factor's allocation the factor is
- * packed (pcg_reclaim); insertions stop (and setup refactors) past
- * PCG_NZMAX_HARD times, or when the fill has doubled */
 /* "supernodal_switch": the flops per entry of L from which the full
  * factorisations go by supernodes under "supernodal" = -1 (the default since
  * 0.2.21). Measured with batched shear (docs/performance.md, 0.2.21), CPU
@@ -149,6 +146,9 @@ typedef struct {
  * price of 3D networks between about 500 and 900 particles. CHOLMOD's own
  * switch is 40. */
 #define PCG_SUPERNODAL_SWITCH 200.0
+/* past PCG_NZMAX_GROWTH times the fresh factor's allocation the factor is
+ * packed (pcg_reclaim); insertions stop (and setup refactors) past
+ * PCG_NZMAX_HARD times, or when the fill has doubled */
 #define PCG_NZMAX_GROWTH 2.5
 #define PCG_NZMAX_HARD 4.0
 
