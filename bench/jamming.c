@@ -55,6 +55,11 @@
  *     O'Hern protocol from an input this program writes; a route missing
  *     from the machine is reported as skipped. CPU seconds per packing and
  *     their ratio to the first route run. ODHS_BENCH_SOFT_LIMIT bounds each run.
+ *     ODHS_BENCH_LP_TOL sets the chain's tolerance of the quench and lp
+ *     routes (default the library's; a looser one leaves work to the end
+ *     game) and ODHS_BENCH_LP_END=batched|own their end game (since 0.2.22;
+ *     odhs_jam_lp_options.own_integrator); the work column adds the mean
+ *     number of end-game steps.
  *
  * Every packing runs in a child process (fork), so a run that exceeds its
  * time limit is killed and reported instead of stalling the benchmark.
@@ -108,6 +113,12 @@ typedef struct {
 } result;
 
 static char solver_name[32] = "dense";
+/* the fast route's settings (table 4): ODHS_BENCH_LP_TOL, the chain's
+ * tolerance (default the library's, 1e-12; a looser one ends the chain
+ * unjammed and shows the end game), ODHS_BENCH_LP_END=batched|own, its end
+ * game (odhs_jam_lp_options.own_integrator; default batched since 0.2.22) */
+static double lp_tol;
+static int lp_own;
 static unsigned correction = 1;
 
 static int certified(const odhs_jam_certificate *c, int dim)
@@ -343,7 +354,7 @@ static void run_packing(result *r, int f0_check)
     if (!r->rc) r->rc = odhs_stepper_create(sys, drv, sol, &st);
     if (!r->rc) r->rc = odhs_stepper_set_correction_interval(st, correction);
     r->lprep.size = sizeof r->lprep;
-    odhs_jam_lp_options lo = {.size = sizeof lo, .quench = r->lp == 2};
+    odhs_jam_lp_options lo = {.size = sizeof lo, .quench = r->lp == 2, .tol = lp_tol, .own_integrator = lp_own};
     if (!r->rc) r->rc = r->lp ? odhs_stepper_jam_lp(st, &lo, &r->lprep) : odhs_stepper_run_until_packing_fraction(st, 0.999);
     r->wall = bench_wall() - t0;
     r->cpu = bench_cpu() - c0;
@@ -669,8 +680,11 @@ static int table4(int workers, double limit)
            "##   compression, soft = the library's soft-sphere route (table 3), lammps = LAMMPS (lmp) doing the\n"
            "##   O'Hern protocol from phi 0.70 (3D: 0.50) (harmonic, FIRE to 1e-14, bisection to 1e-6). CPU s per packing;\n"
            "##   ratio = route CPU / CPU of the first route listed. phi_J: certified packings for quench, lp and\n"
-           "##   events, the last unjammed phi for the soft routes.\n",
-           seeds, first, first + seeds - 1);
+           "##   events, the last unjammed phi for the soft routes. work: programmes and end-game steps (quench, lp),\n"
+           "##   steps (events), minimisations (soft, lammps). Chain tolerance %s, end game %s (ODHS_BENCH_LP_TOL,\n"
+           "##   ODHS_BENCH_LP_END).\n",
+           seeds, first, first + seeds - 1, lp_tol > 0.0 ? "set" : "the library's", lp_own ? "own (Heun)" : "batched");
+    if (lp_tol > 0.0) printf("##   chain tolerance %g\n", lp_tol);
     printf("%-3s %6s %-7s %5s %9s %10s %10s %11s %9s %8s %s\n", "d", "N", "route", "runs", "certified", "cpu_s",
            "cpu_max", "phi_J", "phi_sd", "ratio", "work");
     for (int z = 0; z < ns; ++z) {
@@ -680,7 +694,7 @@ static int table4(int workers, double limit)
             if (rr[0].wall == -2.0) continue;
             size_t run = 0, ok = 0, cert = 0;
             double cpu = 0.0, cmax = 0.0, ph = 0.0, ph2 = 0.0;
-            unsigned long long work = 0;
+            unsigned long long work = 0, end_steps = 0;
             int missing = 0;
             for (int q = 0; q < seeds; ++q) {
                 const result *r = &rr[q];
@@ -695,6 +709,7 @@ static int table4(int workers, double limit)
                 cmax = fmax(cmax, r->cpu);
                 ph += r->cert.phi;
                 ph2 += r->cert.phi * r->cert.phi;
+                if (k <= R_LP) end_steps += r->lprep.end_steps;
                 work += k <= R_LP       ? r->lprep.n_lps
                         : k == R_EVENTS ? r->steps
                                         : r->s_mins;
@@ -715,9 +730,11 @@ static int table4(int workers, double limit)
             char cs[16];
             if (k <= R_EVENTS) snprintf(cs, sizeof cs, "%zu/%zu", cert, run);
             else snprintf(cs, sizeof cs, "-");
-            printf("%-3d %6zu %-7s %5zu %9s %10.2f %10.2f %11.6f %9.5f %8.2f %llu %s\n", sizes[z].dim, sizes[z].n,
+            printf("%-3d %6zu %-7s %5zu %9s %10.2f %10.2f %11.6f %9.5f %8.2f %llu %s", sizes[z].dim, sizes[z].n,
                    route_names[k], run, cs, cpu, cmax, mean, sd, cpu / lp_cpu, work / (unsigned long long)ok,
                    k <= R_LP ? "programmes" : k == R_EVENTS ? "steps" : "minimisations");
+            if (k <= R_LP) printf(", %.1f end-game steps", (double)end_steps / m);
+            printf("\n");
             if (csv)
                 fprintf(csv, "routes,%d,%zu,%zu,%zu,%zu,%.9f,%.3e,,,,,%.2f,%.2f,%llu,,,,,,%s\n", sizes[z].dim,
                         sizes[z].n, run, ok, cert, mean, sd, cpu, cmax, work / (unsigned long long)ok,
@@ -756,6 +773,13 @@ int main(int argc, char **argv)
     }
     /* solver: the first backend this library provides */
     const char *prefs[] = {"cholmod-pcg", "cholmod", "spqr", "dense"};
+    const char *lt = getenv("ODHS_BENCH_LP_TOL"), *le = getenv("ODHS_BENCH_LP_END");
+    if (lt && atof(lt) > 0.0) lp_tol = atof(lt);
+    if (le && strcmp(le, "own") && strcmp(le, "batched")) {
+        fprintf(stderr, "jamming: ODHS_BENCH_LP_END=%s: batched or own\n", le);
+        return 2;
+    }
+    lp_own = le && !strcmp(le, "own");
     const char *cs = getenv("ODHS_BENCH_CORRECTION");
     if (cs && atoi(cs) >= 0) correction = (unsigned)atoi(cs);
     char why[256] = "";

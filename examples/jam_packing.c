@@ -21,6 +21,8 @@ static const char *const protocols[] = {"compress", "shear", "shear+compress", "
 /* --method */
 enum { EVENTS, LP, QUENCH_LP };
 static const char *const methods[] = {"events", "lp", "quench+lp", NULL};
+/* --end-game: how odhs_stepper_jam_lp steps where its chain leaves the packing unjammed */
+static const char *const end_games[] = {"batched", "own", NULL};
 
 /* the integration settings of the options */
 static int configure(odhs_stepper *st, int integrator, double dt, double tol, unsigned long corr)
@@ -72,9 +74,14 @@ static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, do
 }
 
 /* --method lp: the chain of linear programmes and the exact end game */
-static int jam_lp(odhs_stepper *st, double trust, int quench, double quench_phi, int quiet)
+static int jam_lp(odhs_stepper *st, double trust, double lp_tol, int quench, double quench_phi, int own, int quiet)
 {
-    odhs_jam_lp_options o = {.size = sizeof o, .trust = trust, .quench = quench, .quench_phi = quench_phi};
+    odhs_jam_lp_options o = {.size = sizeof o,
+                             .trust = trust,
+                             .tol = lp_tol,
+                             .quench = quench,
+                             .quench_phi = quench_phi,
+                             .own_integrator = own};
     odhs_jam_lp_report r = {.size = sizeof r};
     int rc = odhs_stepper_jam_lp(st, &o, &r);
     if (!quiet && rc == ODHS_JAMMED && quench)
@@ -93,8 +100,9 @@ int main(int argc, char **argv)
 {
     const char *in = NULL, *outpath = NULL, *contacts = NULL, *svg = NULL, *solver_name = CLI_DEFAULT_SOLVER;
     const char *traj = NULL, *traj_contacts = NULL;
-    double dt = 0.0, max_strain = 20.0, tol = 0.0, p_jam = 0.0, traj_every = 0.01, trust = 0.1, quench_phi = 0.0;
-    int protocol = COMPRESS, method = EVENTS, integrator = CLI_DEFAULT_INTEGRATOR, dim = 2, quiet = 0;
+    double dt = 0.0, max_strain = 20.0, tol = 0.0, p_jam = 0.0, traj_every = 0.01, trust = 0.1, quench_phi = 0.0,
+           lp_tol = 0.0;
+    int protocol = COMPRESS, method = EVENTS, integrator = CLI_DEFAULT_INTEGRATOR, dim = 2, quiet = 0, end_game = 0;
     unsigned long corr = 1;
     unsigned long n = 256, seed = 1;
     const cli_opt opts[] = {
@@ -109,6 +117,15 @@ int main(int argc, char **argv)
                        "--method lp, quench+lp: bound on each displacement per programme, in mean diameters (at "
                        "most 0.5)",
                        CLI_POSITIVE),
+        CLI_OPT_DOUBLE("--lp-tol", &lp_tol, "X",
+                       "--method lp, quench+lp: the chain ends when its growth sqrt(Gamma) - 1 falls below X "
+                       "(default: the library's, 1e-12; a looser one leaves more to the end game)",
+                       CLI_POSITIVE),
+        CLI_OPT_LIST("--end-game", &end_game, "E",
+                     "--method lp, quench+lp: how the end game steps where the chain leaves the packing unjammed: "
+                     "batched = batched-event steps, several events per solve (since 0.2.22); own = the steps of "
+                     "--integrator, one event at a time, as up to 0.2.21",
+                     end_games, CLI_ANY),
         CLI_OPT_DOUBLE("--quench-phi", &quench_phi, "X",
                        "--method quench+lp: packing fraction of the quench, below 1 (default: the library's, 0.86 "
                        "in 2D and 0.66 in 3D)",
@@ -197,10 +214,10 @@ int main(int argc, char **argv)
 
     if (protocol == COMPRESS) {
         odhs_driver_set_compression_rate(drv, 1.0);
-        rc = method != EVENTS ? jam_lp(st, trust, method == QUENCH_LP, quench_phi, quiet) : drive(st, drv, 0, 0, 0);
+        rc = method != EVENTS ? jam_lp(st, trust, lp_tol, method == QUENCH_LP, quench_phi, end_game, quiet) : drive(st, drv, 0, 0, 0);
     } else if (protocol == SHEAR) {
         odhs_driver_set_compression_rate(drv, 1.0);
-        rc = method != EVENTS ? jam_lp(st, trust, method == QUENCH_LP, quench_phi, quiet) : drive(st, drv, 0, 0, 0);
+        rc = method != EVENTS ? jam_lp(st, trust, lp_tol, method == QUENCH_LP, quench_phi, end_game, quiet) : drive(st, drv, 0, 0, 0);
         if (rc == ODHS_JAMMED) {
             /* dilate slightly (all contacts open) and shear at fixed volume */
             double phi;

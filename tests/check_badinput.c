@@ -1912,6 +1912,9 @@ static int huge_rate_case(void)
       return odhs_stepper_jam_lp(w->run, &o, NULL);)                                                           \
     X(jam_lp_quench_phi_nan, odhs_stepper_jam_lp, ODHS_E_NONFINITE, NOALT, H_RUN, 0,                           \
       odhs_jam_lp_options o = {.size = sizeof o, .quench = 1, .quench_phi = NAN_};                             \
+      return odhs_stepper_jam_lp(w->run, &o, NULL);)                                                           \
+    X(jam_lp_own_integrator_two, odhs_stepper_jam_lp, ODHS_E_INVALID, NOALT, H_RUN, 0,                         \
+      odhs_jam_lp_options o = {.size = sizeof o, .own_integrator = 2};                                         \
       return odhs_stepper_jam_lp(w->run, &o, NULL);)
 
 /* ---- traj.h, lammps.h and the outputs of 0.2.6 in io.h and stepper.h ------------------ */

@@ -108,8 +108,9 @@ expect 2 "jam_packing --method lp refuses a protocol without a compression stage
     "$bin/jam_packing" --method lp --protocol pressure
 expect_in err "compress and shear only" "jam_packing says which protocols --method lp takes"
 expect 2 "jam_packing --trust beyond half a diameter" -- "$bin/jam_packing" --method lp --trust 0.7
+expect 2 "jam_packing --end-game takes batched or own" -- "$bin/jam_packing" --method lp --end-game fast
 # the quench start (--method quench+lp): certified, in 2D and 3D and with the shear protocol
-for args in "--n 64" "--n 64 --dim 3" "--n 64 --protocol shear" "--n 64 --quench-phi 0.84"; do
+for args in "--n 64" "--n 64 --dim 3" "--n 64 --protocol shear" "--n 64 --quench-phi 0.84" "--n 64 --end-game own"; do
     # shellcheck disable=SC2086
     "$bin/jam_packing" $args --method quench+lp >"$tmp/out" 2>"$tmp/err"
     got=$?

@@ -92,6 +92,11 @@ typedef struct odhs_jam_lp_options {
     int quench;        /* 1: start from a soft-sphere quench; 0: from the configuration */
     double quench_phi; /* the quench's packing fraction, in (0, 1) (default 0.86 in 2D,
                         * 0.66 in 3D: above phi_J of common mixtures)                */
+    /* since 0.2.22: how the end game steps (see below) */
+    int own_integrator; /* 0 (default): batched-event steps (ODHS_INTEGRATOR_BATCHED
+                         * at its default tolerance and dt), the stepper's own
+                         * settings put back on return; 1: the stepper's own
+                         * integrator and settings, as up to 0.2.21           */
 } odhs_jam_lp_options;
 
 /** What odhs_stepper_jam_lp did. Set `size` to sizeof(odhs_jam_lp_report). */
@@ -138,6 +143,24 @@ typedef struct odhs_jam_lp_report {
  * pairs' gaps are second order in the last displacements, up to about 1e-8
  * at 3D N = 8000, above the contact tolerance of 1e-9: without them the
  * network could be short of contacts and the end game stepped.)
+ *
+ * Since 0.2.22 these steps are batched-event steps by default
+ * (opt.own_integrator = 0; the reset then rewires in blocks, as that
+ * integrator's does): where the chain's packing is not yet jammed at the
+ * reset, they take the many openings and closings near jamming several per
+ * solve, and the step that reaches a potentially jammed network is taken
+ * by the exact scheme, whose rewiring and self-stress decide jamming as
+ * before. The packing is certified exactly as before; measured in
+ * docs/jamming.md (3D N = 1000, a chain stopped at tol 1e-8: 1.3-5 times
+ * fewer steps, the same packings, up to 3.3 times less CPU). The exact
+ * steps run at the stepper's own Heun tolerance (Heun's default, 1e-6,
+ * when its integrator is another). The stepper's integrator, tolerance,
+ * dt, step and correction interval are put back before the call returns,
+ * whatever it returns; the batched steps count in
+ * odhs_stepper_batched_stats. During the call the stepper shows the
+ * batched settings (odhs_stepper_get_settings from an event callback, a
+ * checkpoint written there), and settings changed from a callback are
+ * replaced by the saved ones on return.
  *
  * The chain ends with contact gaps up to the LP solver's tolerance; when
  * the end game's polish leaves gaps above 5e-14 (relative; 1e-14 up to

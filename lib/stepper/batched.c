@@ -269,7 +269,12 @@ static int exact_step(odhs_stepper *st, odhs__step_plan *p, double h)
      * than updates */
     double old_um;
     const int pushed = odhs__solver_push_param(st->sol, "update_max", ODHS__BATCH_UPDATE_MAX, &old_um);
+    /* odhs_stepper_jam_lp's end game keeps the exact scheme's accuracy
+     * here (st->tol_exact): its Heun tolerance, not the batched one */
+    const double tol = st->tol;
+    if (st->tol_exact > 0.0) st->tol = st->tol_exact;
     s = odhs__st_advance_exact(st, &odhs__step_heun, p);
+    st->tol = tol;
     odhs__solver_pop_param(st->sol, "update_max", pushed, old_um);
     st->h = hb;
     return s;

@@ -37,6 +37,10 @@ struct odhs_stepper {
     double dt;
     int integrator;   /* ODHS_INTEGRATOR_* */
     double tol;       /* adaptive: error per step, relative to the mean diameter */
+    double tol_exact; /* > 0: the tolerance of the Heun step a batched step falls
+                       * back to (batched.c, exact_step), instead of tol
+                       * (odhs_stepper_jam_lp's end game sets it for the
+                       * duration of the call; not checkpointed) */
     int tol_user;     /* the tolerance was set (not the integrator's default) */
     int dt_user;      /* dt was set (not the integrator's default) */
     double bh;        /* > 0 while the batched step's contact problem is solved:

@@ -640,7 +640,8 @@ class Stepper(Owned):
                            int(c.n_contacts_isostatic), c.z, c.z_backbone, c.force_balance, c.gap_error, c.overlap,
                            c.min_force, int(c.n_pivots))
 
-    def jam_lp(self, trust=0.0, tol=0.0, max_lps=0, max_steps=0, quench=False, quench_phi=0.0):
+    def jam_lp(self, trust=0.0, tol=0.0, max_lps=0, max_steps=0, quench=False, quench_phi=0.0,
+               own_integrator=False):
         """The fast route to a certified jammed packing (odhs_stepper_jam_lp, since 0.2.9): a
         chain of linear programmes compresses the system to jamming, then the stepper's exact
         end game certifies it. The driver must compress and do nothing else. Options left 0
@@ -648,6 +649,9 @@ class Stepper(Owned):
         (since 0.2.10) starts the chain from a soft-sphere quench to quench_phi (default 0.86
         in 2D, 0.66 in 3D), brought toward phi_J by rescalings of its mean overlap (since
         0.2.11) and dilated until no pair overlaps: the fastest route, a quench protocol.
+        Where the chain leaves the packing unjammed, the end game steps with the batched-event
+        integrator (since 0.2.22; the stepper's settings are put back after the call);
+        own_integrator=True steps with the stepper's own integrator instead, as up to 0.2.21.
         Returns (status, JamLpReport); status is Status.JAMMED when the packing is made."""
         o = ffi.new("odhs_jam_lp_options *")
         o.size = ffi.sizeof("odhs_jam_lp_options")
@@ -657,6 +661,7 @@ class Stepper(Owned):
         o.quench = 1 if quench else 0
         o.quench_phi = float(quench_phi)
         o.max_steps = int(max_steps)
+        o.own_integrator = 1 if own_integrator else 0
         r = ffi.new("odhs_jam_lp_report *")
         r.size = ffi.sizeof("odhs_jam_lp_report")
         rc = lib.odhs_stepper_jam_lp(self._p or self._closed(), o, r)

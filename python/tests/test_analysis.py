@@ -160,3 +160,29 @@ def test_jam_lp_quench_certified():
     assert c.min_force > 0 and rep.quench_iterations > 0 and 0.7 < rep.phi_start < 0.86 and rep.phi_start < c.phi
     # since 0.2.11 the quench is rescaled toward phi_J before the chain starts
     assert 1 <= rep.quench_steps <= 4 and rep.phi_start > c.phi - 0.01
+
+
+def test_jam_lp_batched_end_game():
+    # since 0.2.22 the end game steps with the batched integrator where the chain leaves the
+    # packing unjammed (a chain stopped at tol 1e-6: 2D N = 256, seed 4), and puts the
+    # stepper's settings back; own_integrator=True steps with the stepper's own integrator
+    out = []
+    for own in (False, True):
+        s = odhs.System(2, 256)
+        s.set_radii_bidisperse(0.5, 1.4, 0.03, 4)
+        s.place_random(0.45, 5)
+        st = odhs.Stepper(s, odhs.Driver(compression_rate=1.0), odhs.Solver("dense"), correction_interval=1)
+        st.tolerance = 2e-6
+        before = st.settings
+        try:
+            status, rep = st.jam_lp(quench=True, tol=1e-6, own_integrator=own)
+        except odhs.NotInstalledError:
+            pytest.skip("libodhs built without CLP")
+        assert status == odhs.Status.JAMMED and st.settings == before
+        c = st.certificate()
+        assert c.jammed and c.isostatic and c.force_balance < 1e-12 and c.gap_error < 1e-13 and c.overlap <= 1e-14
+        assert c.min_force > 0
+        b = st.batched_stats
+        assert (b.batched_steps + b.exact_steps == rep.end_steps) if not own else (b.batched_steps + b.exact_steps == 0)
+        out.append((rep.end_steps, c.phi))
+    assert 0 < out[0][0] < out[1][0] and abs(out[0][1] - out[1][1]) < 1e-12
