@@ -681,10 +681,9 @@ static int table4(int workers, double limit)
            "##   O'Hern protocol from phi 0.70 (3D: 0.50) (harmonic, FIRE to 1e-14, bisection to 1e-6). CPU s per packing;\n"
            "##   ratio = route CPU / CPU of the first route listed. phi_J: certified packings for quench, lp and\n"
            "##   events, the last unjammed phi for the soft routes. work: programmes and end-game steps (quench, lp),\n"
-           "##   steps (events), minimisations (soft, lammps). Chain tolerance %s, end game %s (ODHS_BENCH_LP_TOL,\n"
-           "##   ODHS_BENCH_LP_END).\n",
-           seeds, first, first + seeds - 1, lp_tol > 0.0 ? "set" : "the library's", lp_own ? "own (Heun)" : "batched");
-    if (lp_tol > 0.0) printf("##   chain tolerance %g\n", lp_tol);
+           "##   steps (events), minimisations (soft, lammps). Chain tolerance %g (0: the library's), end game %s\n"
+           "##   (ODHS_BENCH_LP_TOL, ODHS_BENCH_LP_END).\n",
+           seeds, first, first + seeds - 1, lp_tol, lp_own ? "own (Heun)" : "batched");
     printf("%-3s %6s %-7s %5s %9s %10s %10s %11s %9s %8s %s\n", "d", "N", "route", "runs", "certified", "cpu_s",
            "cpu_max", "phi_J", "phi_sd", "ratio", "work");
     for (int z = 0; z < ns; ++z) {
@@ -774,7 +773,11 @@ int main(int argc, char **argv)
     /* solver: the first backend this library provides */
     const char *prefs[] = {"cholmod-pcg", "cholmod", "spqr", "dense"};
     const char *lt = getenv("ODHS_BENCH_LP_TOL"), *le = getenv("ODHS_BENCH_LP_END");
-    if (lt && atof(lt) > 0.0) lp_tol = atof(lt);
+    if (lt && !(atof(lt) > 0.0 && atof(lt) < 1.0)) {
+        fprintf(stderr, "jamming: ODHS_BENCH_LP_TOL=%s: a tolerance in (0, 1)\n", lt);
+        return 2;
+    }
+    if (lt) lp_tol = atof(lt);
     if (le && strcmp(le, "own") && strcmp(le, "batched")) {
         fprintf(stderr, "jamming: ODHS_BENCH_LP_END=%s: batched or own\n", le);
         return 2;

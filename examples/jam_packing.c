@@ -73,7 +73,7 @@ static int drive(odhs_stepper *st, odhs_driver *drv, int shear, int pressure, do
     return ODHS_OK;
 }
 
-/* --method lp: the chain of linear programmes and the exact end game */
+/* --method lp: the chain of linear programmes (--lp-tol) and the end game (--end-game) */
 static int jam_lp(odhs_stepper *st, double trust, double lp_tol, int quench, double quench_phi, int own, int quiet)
 {
     odhs_jam_lp_options o = {.size = sizeof o,
