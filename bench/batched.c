@@ -32,7 +32,8 @@
  *        batched --plot TABLE SVG: fits and plot of a table printed by an
  *          earlier run (one cut short included)
  *        batched --memory DIM N [NBUILD [STEPS]]: STEPS (default 5) batched
- *          steps at N (tiled from N / 2^DIM ... down to NBUILD), peak RSS
+ *          steps at N (tiled from N / 2^DIM ... down to NBUILD), peak RSS;
+ *          ODHS_BENCH_SAVE_START=FILE.ckpt writes the start (for --from)
  *        batched --accuracy DIM N SEEDS STRAIN: steady-state sxy, p, z and
  *          collisions per unit strain of exact and batched runs (block
  *          means, SEEDS starts, over STRAIN each), and the convergence of
@@ -85,13 +86,15 @@ enum { S_EXACT, S_BATCHED, S_TIGHT, S_COUNT };
  * (-1 = the default since 0.2.21, 0, 1) for the shear and compression runs;
  * ODHS_BENCH_SUPERNODAL_SWITCH and ODHS_BENCH_OPENMP: "supernodal_switch"
  * (negative: the default) and "openmp" */
-static double pcg_supernodal = -1.0, pcg_switch = -1.0, cm_openmp = 0.0;
+static double pcg_supernodal = -1.0, pcg_switch = -1.0, cm_openmp = 0.0, pcg_ordering = NAN, pcg_reuse = NAN;
 static int auto_solver(odhs_solver **sol)
 {
     int rc = odhs_solver_create_by_name("auto", sol);
     if (!rc && pcg_supernodal != -1.0) rc = odhs_solver_set_param(*sol, "supernodal", pcg_supernodal);
     if (!rc && pcg_switch >= 0.0) rc = odhs_solver_set_param(*sol, "supernodal_switch", pcg_switch);
     if (!rc && cm_openmp != 0.0) rc = odhs_solver_set_param(*sol, "openmp", cm_openmp);
+    if (!rc && !isnan(pcg_ordering)) rc = odhs_solver_set_param(*sol, "ordering", pcg_ordering);
+    if (!rc && !isnan(pcg_reuse)) rc = odhs_solver_set_param(*sol, "ordering_reuse", pcg_reuse);
     return rc;
 }
 /* strain of the scan's warm-up (batched): ODHS_BENCH_WARMUP, default 0.3.
@@ -322,6 +325,8 @@ static int memory(int dim, size_t n, size_t nbuild, int nsteps)
     odhs_driver *drv;
     odhs_stepper *st = shear_stepper(sys, S_BATCHED, &sol, &drv);
     int rc = odhs_stepper_reset(st);
+    const char *save = getenv("ODHS_BENCH_SAVE_START");
+    if (!rc && save && *save) rc = odhs_checkpoint_write(st, save);
     double cs = bench_cpu();
     {
         struct rusage r0;
@@ -354,6 +359,12 @@ static int memory(int dim, size_t n, size_t nbuild, int nsteps)
            "%.1f CPU s, peak RSS %.1f MiB\n",
            dim, n, tb, nsteps, rc, rc ? odhs_stepper_errmsg(st) : "ok", g1 - g0, (unsigned long long)co,
            bench_cpu() - c0, ru.ru_maxrss / 1024.0);
+    double fa = NAN, an = NAN, ord = NAN, lnz = NAN;
+    odhs_solver_get_stat(sol, "factorizations", &fa);
+    odhs_solver_get_stat(sol, "analyses", &an);
+    odhs_solver_get_stat(sol, "orderings", &ord);
+    odhs_solver_get_stat(sol, "lnz", &lnz);
+    printf("# solver: %.0f factorizations, %.0f analyses, %.0f orderings, lnz %.0f\n", fa, an, ord, lnz);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);
@@ -732,7 +743,8 @@ static int from_file(const char *path, double w, const char *setting)
     odhs_solver_get_stat(sol, "fallbacks", &fails);
     odhs_solver_get_stat(sol, "fallback_solves", &fb);
     odhs_solver_get_stat(sol, "rank_deficient", &rdef);
-    double fl = NAN, lnz = NAN;
+    double fl = NAN, lnz = NAN, orderings = NAN;
+    odhs_solver_get_stat(sol, "orderings", &orderings);
     odhs_solver_get_stat(sol, "flops", &fl);
     odhs_solver_get_stat(sol, "lnz", &lnz);
     if (!rc) odhs_stepper_shear_stress(st, &sxy);
@@ -740,10 +752,11 @@ static int from_file(const char *path, double w, const char *setting)
            odhs_system_count(sys), w, path, rc, rc ? ": " : "", rc ? odhs_stepper_errmsg(st) : "");
     printf("cpu_s %.2f reset_s %.2f steps %llu exact_steps %llu collisions %llu openings %llu contact_problem_solves %llu "
            "corrections %llu correction_passes %llu correction_closed %llu factorizations %.0f analyses %.0f "
-           "failed_attempts %.0f fallback_solves %.0f rank_deficient_solves %.0f sxy_end %.6f flops_per_lnz %.1f\n",
+           "failed_attempts %.0f fallback_solves %.0f rank_deficient_solves %.0f sxy_end %.6f flops_per_lnz %.1f "
+           "orderings %.0f lnz %.0f\n",
            cpu, cr, (unsigned long long)steps, (unsigned long long)esteps, (unsigned long long)col, (unsigned long long)op,
            (unsigned long long)bsol, (unsigned long long)corr, (unsigned long long)passes, (unsigned long long)closed,
-           fact, analyses, fails, fb, rdef, sxy, fl / lnz);
+           fact, analyses, fails, fb, rdef, sxy, fl / lnz, orderings, lnz);
     odhs_stepper_destroy(st);
     odhs_driver_destroy(drv);
     odhs_solver_destroy(sol);
@@ -1259,6 +1272,22 @@ int main(int argc, char **argv)
         pcg_switch = atof(sw);
         if (!(pcg_switch >= 0.0)) {
             fprintf(stderr, "batched: ODHS_BENCH_SUPERNODAL_SWITCH must be >= 0\n");
+            return 2;
+        }
+    }
+    const char *ordv = getenv("ODHS_BENCH_ORDERING");
+    if (ordv) {
+        pcg_ordering = atof(ordv);
+        if (pcg_ordering != -1.0 && pcg_ordering != 0.0 && pcg_ordering != 1.0) {
+            fprintf(stderr, "batched: ODHS_BENCH_ORDERING must be -1, 0 or 1\n");
+            return 2;
+        }
+    }
+    const char *reu = getenv("ODHS_BENCH_ORDERING_REUSE");
+    if (reu) {
+        pcg_reuse = atof(reu);
+        if (!(pcg_reuse == -1.0 || pcg_reuse == 0.0 || pcg_reuse >= 1.0)) {
+            fprintf(stderr, "batched: ODHS_BENCH_ORDERING_REUSE must be -1, 0 or >= 1\n");
             return 2;
         }
     }

@@ -1087,13 +1087,11 @@ static void files_capture(const af_fix *f, const af_scenario *sc, int op, af_buf
 
 static void files_final(af_fix *f, const af_scenario *sc) { check_network(f->net, sc->name); }
 
-/* -- lsq: auto's least-squares routes on a hyperstatic network (a periodic
- * 4 x 4 square lattice: 32 contacts, rank 24) with lsq_dense_max = 0, so
- * that SuiteSparse builds answer with lsq-pcg (lsq-cg absorbs its
- * failures), twice: its first setup and a solve on the kept handle -------- */
-static void lsq_setup(af_fix *f, const af_scenario *sc)
+/* the system of the lsq and pcg_ordering scenarios: 16 discs of diameter 1
+ * on a periodic 4 x 4 square lattice, all touching their four neighbours,
+ * and an empty network */
+static void lattice16(af_fix *f)
 {
-    (void)sc;
     double L[2] = {4.0, 4.0}, r[16], x[32];
     for (int i = 0; i < 16; ++i) {
         r[i] = 0.5;
@@ -1103,6 +1101,16 @@ static void lsq_setup(af_fix *f, const af_scenario *sc)
     AF_OK(odhs_system_create(2, 16, &f->sys));
     AF_OK(odhs_system_set_configuration(f->sys, L, 0.0, r, x));
     AF_OK(odhs_network_create(f->sys, &f->net));
+}
+
+/* -- lsq: auto's least-squares routes on a hyperstatic network (a periodic
+ * 4 x 4 square lattice: 32 contacts, rank 24) with lsq_dense_max = 0, so
+ * that SuiteSparse builds answer with lsq-pcg (lsq-cg absorbs its
+ * failures), twice: its first setup and a solve on the kept handle -------- */
+static void lsq_setup(af_fix *f, const af_scenario *sc)
+{
+    (void)sc;
+    lattice16(f);
     AF_OK(odhs_network_detect(f->net, f->sys, 1e-9));
     f->nc = odhs_network_count(f->net);
     AF_ASSERT(f->nc == 32);
@@ -1145,6 +1153,87 @@ static void lsq_final(af_fix *f, const af_scenario *sc)
     free(sx);
     free(res);
 }
+
+#ifdef ODHS_HAVE_SUITESPARSE
+/* -- pcg_ordering: cholmod-pcg carrying its ordering over to a changed
+ * contact set (0.2.23; "ordering_reuse" forced, since the default carries
+ * only after METIS, on networks far larger than this one; with any fill)
+ * and every change refactorised ("update_max" 0). A spanning tree of a
+ * 4 x 4 square lattice (15 contacts: rows but their last link, column 0 but
+ * its last): solve; swap one row link for the missing one of its row
+ * (another tree); the geometry; solve on the carried ordering ----------- */
+static void pcgo_setup(af_fix *f, const af_scenario *sc)
+{
+    (void)sc;
+    lattice16(f);
+    for (int row = 0; row < 4; ++row)
+        for (int c = 0; c < 3; ++c)
+            AF_OK(odhs_network_add(f->net, (size_t)(4 * row + c), (size_t)(4 * row + c + 1), ODHS_CONTACT_TEMPORARY));
+    for (int row = 0; row < 3; ++row)
+        AF_OK(odhs_network_add(f->net, (size_t)(4 * row), (size_t)(4 * row + 4), ODHS_CONTACT_TEMPORARY));
+    AF_OK(odhs_network_update_geometry(f->net, f->sys));
+    f->nc = odhs_network_count(f->net);
+    AF_ASSERT(f->nc == 15);
+    f->b = malloc(f->nc * sizeof *f->b);
+    f->x1 = calloc(f->nc, sizeof *f->x1);
+    AF_ASSERT(f->b && f->x1);
+    for (size_t k = 0; k < f->nc; ++k) f->b[k] = 1.0 + 0.3 * sin(1.0 + (double)k);
+}
+
+static int pcgo_op(af_fix *f, const af_scenario *sc, int k)
+{
+    (void)sc;
+    switch (k) {
+    case 0: {
+        int s = odhs_solver_create_by_name("cholmod-pcg", &f->sol);
+        if (!s) s = odhs_solver_set_param(f->sol, "ordering_reuse", 1e6); /* whatever the fill */
+        if (!s) s = odhs_solver_set_param(f->sol, "update_max", 0.0);
+        return s;
+    }
+    case 1:
+    case 4: memset(f->x1, 0, f->nc * sizeof *f->x1); return odhs_solver_solve(f->sol, f->net, f->b, f->x1);
+    case 2: { /* row 1 swaps its link 5-6 for 7-4 (around the periodic box); all or nothing */
+        int s = odhs_network_add(f->net, 7, 4, ODHS_CONTACT_TEMPORARY);
+        if (!s) {
+            s = odhs_network_remove(f->net, 5, 6);
+            if (s) AF_OK(odhs_network_remove(f->net, 7, 4));
+        }
+        return s;
+    }
+    default: return odhs_network_update_geometry(f->net, f->sys);
+    }
+}
+
+static void pcgo_capture(const af_fix *f, const af_scenario *sc, int op, af_buf *b)
+{
+    (void)sc;
+    (void)op;
+    rec_system(b, "sys", f->sys);
+    rec_network(b, "net", f->net);
+}
+
+static void pcgo_final(af_fix *f, const af_scenario *sc)
+{
+    /* the answer of the last solve: N x = b to 1e-10, on the carried ordering */
+    double *y = malloc(f->nc * sizeof *y), *tmp = malloc(32 * sizeof *tmp);
+    AF_ASSERT(y && tmp);
+    AF_OK(odhs_network_apply_N(f->net, f->x1, y, tmp));
+    double rn = 0.0, bn = 0.0;
+    for (size_t c = 0; c < f->nc; ++c) {
+        rn += (y[c] - f->b[c]) * (y[c] - f->b[c]);
+        bn += f->b[c] * f->b[c];
+    }
+    AF_MSG(sqrt(rn) < 1e-10 * sqrt(bn), "%s: |N x - b| = %.3g", sc->name, sqrt(rn));
+    /* two analyses; the second carried the first's ordering, unless a failed
+     * allocation while keeping it was absorbed (then it ordered afresh) */
+    double ord = 0.0, an = 0.0;
+    AF_OK(odhs_solver_get_stat(f->sol, "orderings", &ord));
+    AF_OK(odhs_solver_get_stat(f->sol, "analyses", &an));
+    AF_MSG(an >= 2.0 && ord >= 1.0 && ord <= an, "%s: %g orderings for %g analyses", sc->name, ord, an);
+    free(y);
+    free(tmp);
+}
+#endif
 
 /* -- outputs: contacts CSV, LAMMPS data file written and read, a trajectory
  * of two frames with velocities, read back ----------------------------------- */
@@ -1572,6 +1661,9 @@ static const af_scenario scenarios[] = {
     {"jam_quench", 7, 1, jam_lp_setup, NULL, jam_lp_op, jam_lp_capture, jam_lp_final},
 #endif
     {"lsq", 2, 0, lsq_setup, NULL, lsq_op, lsq_capture, lsq_final},
+#ifdef ODHS_HAVE_SUITESPARSE
+    {"pcg_ordering", 5, 0, pcgo_setup, NULL, pcgo_op, pcgo_capture, pcgo_final},
+#endif
     {"files", 2, 0, files_setup, NULL, files_op, files_capture, files_final},
     {"analysis", 6, 0, analysis_setup, NULL, analysis_op, analysis_capture, files_final},
     {"outputs", 8, 0, outputs_setup, NULL, outputs_op, outputs_capture, outputs_final},

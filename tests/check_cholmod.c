@@ -164,6 +164,15 @@ static odhs_solver *cm_by_name(const char *name)
     return s;
 }
 
+/* cholmod-pcg with these "ordering" and "ordering_reuse" (since 0.2.23) */
+static odhs_solver *cm_pcg_ordered(double ordering, double reuse)
+{
+    odhs_solver *p = cm_new(&odhs_solver_type_cholmod_pcg);
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering", ordering), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering_reuse", reuse), ODHS_OK);
+    return p;
+}
+
 static double cm_stat(const odhs_solver *s, const char *key)
 {
     double v = NAN;
@@ -1007,20 +1016,31 @@ START_TEST(test_stepper_shear)
     odhs_system *base = cm_scene(2, 64, 0.80, 5, NULL);
     const int nsteps = 400;
     odhs_solver *cg = cm_by_name("cg"), *ch = cm_new(&odhs_solver_type_cholmod),
-                *pc = cm_new(&odhs_solver_type_cholmod_pcg);
-    uint64_t ecg, ech, epc;
+                *pc = cm_new(&odhs_solver_type_cholmod_pcg), *pr = cm_pcg_ordered(1.0, 1.25);
+    uint64_t ecg, ech, epc, epr;
     double *scg = cm_shear_series(base, cg, nsteps, &ecg);
     double *sch = cm_shear_series(base, ch, nsteps, &ech);
     double *spc = cm_shear_series(base, pc, nsteps, &epc);
+    /* pcg on carried METIS orderings (0.2.23): slots, updates and rewiring on them */
+    double *spr = cm_shear_series(base, pr, nsteps, &epr);
     ck_assert_msg(ecg > 5, "only %llu events", (unsigned long long)ecg);
     ck_assert_uint_eq(ech, ecg);
     ck_assert_uint_eq(epc, ecg);
-    double smax = 0.0, d1 = 0.0, d2 = 0.0;
+    ck_assert_uint_eq(epr, ecg);
+    double smax = 0.0, d1 = 0.0, d2 = 0.0, d3 = 0.0;
     for (int k = 0; k < nsteps; ++k) {
         smax = fmax(smax, fabs(scg[k]));
         d1 = fmax(d1, fabs(sch[k] - scg[k]));
         d2 = fmax(d2, fabs(spc[k] - scg[k]));
+        d3 = fmax(d3, fabs(spr[k] - scg[k]));
     }
+    cm_note("stepper, pcg on carried orderings: max diff %.2e; %g analyses, %g orderings", d3, cm_stat(pr, "analyses"),
+            cm_stat(pr, "orderings"));
+    ck_assert_msg(d3 <= 1e-9 * smax, "cholmod-pcg, carried orderings, vs cg: max stress difference %g", d3);
+    ck_assert_msg(cm_stat(pr, "orderings") < cm_stat(pr, "analyses"), "%g orderings for %g analyses",
+                  cm_stat(pr, "orderings"), cm_stat(pr, "analyses"));
+    free(spr);
+    odhs_solver_destroy(pr);
     ck_assert(smax > 0.0);
     cm_note("stepper: %d steps, %llu events; max |sigma_xy| %.6g; max diff cholmod %.2e, pcg %.2e; cholmod %g analyses "
             "%g factorizations; pcg %g updates %g factorizations %g analyses",
@@ -1135,6 +1155,234 @@ START_TEST(test_pcg_supernodal)
     free(x1);
     odhs_network_destroy(net);
     odhs_system_destroy(sys);
+}
+END_TEST
+
+/* cholmod-pcg's "ordering" and "ordering_reuse" (since 0.2.23). "ordering":
+ * -1 CHOLMOD's choice (AMD, and METIS too when AMD's fill is high; the
+ * default), 0 AMD, 1 METIS of the contact matrix: each gives the dense
+ * backend's answer on 2D and 3D packings. "ordering_reuse" X >= 1: an
+ * analysis for a changed contact set carries the last ordering over (kept
+ * contacts keep their rank, new ones go last) instead
+ * of ordering afresh, while the fill per contact stays within X times the
+ * last fresh ordering's; 0 orders every analysis afresh; -1 (the default)
+ * carries with X = 1.1 after a fresh ordering that called METIS. */
+
+START_TEST(test_pcg_ordering)
+{
+    odhs_network *net3 = NULL; /* the 3D packing, kept for the stale case */
+    odhs_system *sys3 = NULL;
+    for (int dim = 2; dim <= 3; ++dim) {
+        odhs_network *net = NULL;
+        odhs_system *sys = cm_scene(dim, 200, dim == 2 ? 0.82 : 0.62, 40 + (uint64_t)dim, &net);
+        size_t nc = odhs_network_count(net);
+        tu_rng rng;
+        tu_rng_seed(&rng, 41);
+        double *b = malloc(nc * sizeof *b), *x = calloc(nc, sizeof *x);
+        ck_assert(b && x);
+        cm_rhs(net, &rng, b);
+        for (int o = -1; o <= 1; ++o) {
+            odhs_solver *p = cm_pcg_ordered((double)o, 0.0);
+            memset(x, 0, nc * sizeof *x);
+            double d = cm_vs_dense(p, net, b, x);
+            cm_note("ordering %d, %dD packing N = 200, Nc = %zu: diff %.2e, lnz %g, flops %g", o, dim, nc, d,
+                    cm_stat(p, "lnz"), cm_stat(p, "flops"));
+            ck_assert_msg(d < 1e-10, "ordering %d, %dD: pcg vs dense %g", o, dim, d);
+            ck_assert_double_eq(cm_stat(p, "ordering"), (double)o);
+            ck_assert_double_eq(cm_stat(p, "analyses"), 1.0);
+            ck_assert_double_eq(cm_stat(p, "orderings"), 1.0);
+            ck_assert(cm_stat(p, "iterations") <= 3.0); /* a fresh exact factor */
+            odhs_solver_destroy(p);
+        }
+        free(b);
+        free(x);
+        if (dim == 3) {
+            net3 = net;
+            sys3 = sys;
+        } else {
+            odhs_network_destroy(net);
+            odhs_system_destroy(sys);
+        }
+    }
+
+    /* contact changes, each refactorised with a new analysis (update_max 0).
+     * mode 0: reuse off, an ordering per analysis; 1: reuse 1.25, one
+     * ordering for all and a fill within the bound; 2: the default (-1) on
+     * a network that AMD alone orders (fill below 5x): off; 3: the default
+     * with METIS forced ("ordering" 1): carried */
+    const double mode_order[4] = {-1.0, -1.0, -1.0, 1.0}, mode_reuse[4] = {0.0, 1.25, -1.0, -1.0};
+    for (int mode = 0; mode < 4; ++mode) {
+        cm_case c = cm_random_case(3, 200, 43, 60);
+        tu_rng rng;
+        tu_rng_seed(&rng, 44);
+        size_t nmax = c.nc + 40;
+        double *b = malloc(nmax * sizeof *b), *x = calloc(nmax, sizeof *x);
+        ck_assert(b && x);
+        odhs_solver *p = cm_new(&odhs_solver_type_cholmod_pcg);
+        ck_assert_double_eq(cm_stat(p, "ordering_reuse"), -1.0); /* the default */
+        ck_assert_double_eq(cm_stat(p, "ordering"), -1.0);
+        ck_assert_int_eq(odhs_solver_set_param(p, "ordering", mode_order[mode]), ODHS_OK);
+        ck_assert_int_eq(odhs_solver_set_param(p, "ordering_reuse", mode_reuse[mode]), ODHS_OK);
+        ck_assert_int_eq(odhs_solver_set_param(p, "update_max", 0.0), ODHS_OK);
+        cm_rhs(c.net, &rng, b);
+        ck_assert(cm_vs_dense(p, c.net, b, x) < 1e-10);
+        double fresh0 = cm_stat(p, "lnz") / (double)odhs_network_count(c.net);
+        double bound = mode_reuse[mode] > 0.0 ? mode_reuse[mode] : 1.1;
+        for (int op = 0; op < 12; ++op) {
+            random_change(&c, &rng, c.nc - 6, c.nc + 6);
+            size_t nc = odhs_network_count(c.net);
+            cm_rhs(c.net, &rng, b);
+            memset(x, 0, nc * sizeof *x);
+            double d = cm_vs_dense(p, c.net, b, x);
+            ck_assert_msg(d < 1e-10, "mode %d, op %d: pcg vs dense %g", mode, op, d);
+            ck_assert(cm_stat(p, "iterations") <= 3.0);
+            /* carried or fresh, never beyond the bound */
+            if (cm_stat(p, "orderings") == 1.0)
+                ck_assert_msg(cm_stat(p, "lnz") / (double)nc <= bound * fresh0 * (1.0 + 1e-12),
+                              "mode %d, op %d: lnz per contact %g, fresh %g", mode, op,
+                              cm_stat(p, "lnz") / (double)nc, fresh0);
+        }
+        double an = cm_stat(p, "analyses"), ord = cm_stat(p, "orderings");
+        /* the fill of the carried ordering against a fresh one on the final network */
+        odhs_solver *f = cm_pcg_ordered(mode_order[mode], 0.0);
+        size_t nc = odhs_network_count(c.net);
+        memset(x, 0, nc * sizeof *x);
+        ck_assert(cm_vs_dense(f, c.net, b, x) < 1e-10);
+        cm_note("mode %d (ordering %g, reuse %g): %g analyses, %g orderings; lnz %g, fresh ordering %g", mode,
+                mode_order[mode], mode_reuse[mode], an, ord, cm_stat(p, "lnz"), cm_stat(f, "lnz"));
+        ck_assert_msg(an >= 10.0, "mode %d: %g analyses", mode, an);
+        if (mode == 1 || mode == 3) { /* 1.1 lets the fill of this small network pass its bound now and then */
+            ck_assert_msg(mode == 1 ? ord <= 2.0 : ord <= 0.5 * an, "mode %d: %g orderings in %g analyses", mode, ord,
+                          an);
+            ck_assert(cm_stat(p, "lnz") <= bound * bound * cm_stat(f, "lnz"));
+        } else
+            ck_assert_msg(ord == an, "mode %d: %g orderings in %g analyses", mode, ord, an);
+        odhs_solver_destroy(f);
+        odhs_solver_destroy(p);
+        free(b);
+        free(x);
+        cm_case_free(&c);
+    }
+
+    /* stale: the ordering of a thinned packing network (every third contact
+     * kept) fills much more per contact on the whole network; that analysis
+     * orders afresh, with the fill of a fresh solver */
+    odhs_network *net = net3, *thin = NULL;
+    odhs_system *sys = sys3;
+    size_t nc = odhs_network_count(net);
+    ck_assert_int_eq(odhs_network_create(sys, &thin), ODHS_OK);
+    for (size_t k = 0; k < nc; k += 3) {
+        size_t i, j;
+        ck_assert_int_eq(odhs_network_get_contact(net, k, &i, &j, NULL), ODHS_OK);
+        ck_assert_int_eq(odhs_network_add(thin, i, j, ODHS_CONTACT_TEMPORARY), ODHS_OK);
+    }
+    ck_assert_int_eq(odhs_network_update_geometry(thin, sys), ODHS_OK);
+    tu_rng rng;
+    tu_rng_seed(&rng, 46);
+    double *b = malloc(nc * sizeof *b), *x = calloc(nc, sizeof *x);
+    ck_assert(b && x);
+    odhs_solver *p = cm_pcg_ordered(-1.0, 1.15), *f = cm_pcg_ordered(-1.0, 0.0);
+    cm_rhs(thin, &rng, b);
+    ck_assert(cm_vs_dense(p, thin, b, x) < 1e-10);
+    double lnz_thin = cm_stat(p, "lnz") / (double)odhs_network_count(thin);
+    cm_rhs(net, &rng, b);
+    memset(x, 0, nc * sizeof *x);
+    ck_assert(cm_vs_dense(p, net, b, x) < 1e-10);
+    memset(x, 0, nc * sizeof *x);
+    ck_assert(cm_vs_dense(f, net, b, x) < 1e-10);
+    cm_note("stale ordering: lnz per contact %g thinned, %g whole; %g orderings", lnz_thin,
+            cm_stat(p, "lnz") / (double)nc, cm_stat(p, "orderings"));
+    ck_assert_double_eq(cm_stat(p, "orderings"), 2.0);
+    ck_assert_double_eq(cm_stat(p, "analyses"), 3.0); /* the thinned, the carried one rejected, the fresh one */
+    ck_assert_double_eq(cm_stat(p, "lnz"), cm_stat(f, "lnz"));
+    /* the carried permutation is the one analysed: a new analysis of the
+     * same contacts (forced by a new "supernodal_switch") on the carried
+     * METIS ordering has METIS's fill to the entry */
+    {
+        odhs_solver *m = cm_pcg_ordered(1.0, 1.5);
+        memset(x, 0, nc * sizeof *x);
+        ck_assert(cm_vs_dense(m, net, b, x) < 1e-10);
+        double lnz_metis = cm_stat(m, "lnz");
+        ck_assert_int_eq(odhs_solver_set_param(m, "supernodal_switch", 1e6), ODHS_OK);
+        ck_assert_int_eq(odhs_network_update_geometry(net, sys), ODHS_OK);
+        memset(x, 0, nc * sizeof *x);
+        ck_assert(cm_vs_dense(m, net, b, x) < 1e-10);
+        ck_assert_double_eq(cm_stat(m, "analyses"), 2.0);
+        ck_assert_double_eq(cm_stat(m, "orderings"), 1.0);
+        ck_assert_double_eq(cm_stat(m, "lnz"), lnz_metis);
+        odhs_solver_destroy(m);
+    }
+    /* new contacts go last: from the packing without every tenth contact
+     * to the whole, the carried ordering (never rejected) fills within 1.3
+     * times a fresh one (1.17; ranked right after their latest neighbour
+     * instead, the new contacts coupled subtrees: 1.39) */
+    {
+        odhs_network *most = NULL;
+        ck_assert_int_eq(odhs_network_create(sys, &most), ODHS_OK);
+        for (size_t k = 0; k < nc; ++k) {
+            if (k % 10 == 5) continue;
+            size_t i, j;
+            ck_assert_int_eq(odhs_network_get_contact(net, k, &i, &j, NULL), ODHS_OK);
+            ck_assert_int_eq(odhs_network_add(most, i, j, ODHS_CONTACT_TEMPORARY), ODHS_OK);
+        }
+        ck_assert_int_eq(odhs_network_update_geometry(most, sys), ODHS_OK);
+        odhs_solver *m = cm_pcg_ordered(-1.0, 1e6);
+        cm_rhs(most, &rng, b);
+        memset(x, 0, nc * sizeof *x);
+        ck_assert(cm_vs_dense(m, most, b, x) < 1e-10);
+        cm_rhs(net, &rng, b);
+        memset(x, 0, nc * sizeof *x);
+        ck_assert(cm_vs_dense(m, net, b, x) < 1e-10);
+        ck_assert_double_eq(cm_stat(m, "orderings"), 1.0);
+        cm_note("new contacts last: lnz carried %g, fresh %g", cm_stat(m, "lnz"), cm_stat(f, "lnz"));
+        ck_assert_msg(cm_stat(m, "lnz") <= 1.3 * cm_stat(f, "lnz"), "carried lnz %g, fresh %g", cm_stat(m, "lnz"),
+                      cm_stat(f, "lnz"));
+        odhs_solver_destroy(m);
+        odhs_network_destroy(most);
+    }
+    /* another system (other N): ordered afresh */
+    cm_case c2 = cm_random_case(3, 250, 47, 80);
+    odhs_network *net2 = c2.net;
+    size_t nc2 = odhs_network_count(net2);
+    double *b2 = malloc(nc2 * sizeof *b2), *x2 = calloc(nc2, sizeof *x2);
+    ck_assert(b2 && x2);
+    cm_rhs(net2, &rng, b2);
+    ck_assert(cm_vs_dense(p, net2, b2, x2) < 1e-10);
+    ck_assert_double_eq(cm_stat(p, "orderings"), 3.0);
+    /* bad values leave the parameters as they were */
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering", 2.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering", 0.5), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering", -2.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering_reuse", 0.5), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering_reuse", -0.5), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(p, "ordering_reuse", -2.0), ODHS_E_INVALID);
+    ck_assert_int_ne(odhs_solver_set_param(p, "ordering_reuse", NAN), ODHS_OK); /* refused before the backend */
+    ck_assert_double_eq(cm_stat(p, "ordering"), -1.0);
+    ck_assert_double_eq(cm_stat(p, "ordering_reuse"), 1.15);
+    /* through auto, which hands both on */
+    odhs_solver *a = cm_by_name("auto");
+    ck_assert_int_eq(odhs_solver_set_param(a, "ordering", 1.0), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(a, "ordering_reuse", 1.5), ODHS_OK);
+    ck_assert_int_eq(odhs_solver_set_param(a, "ordering", 5.0), ODHS_E_INVALID);
+    ck_assert_int_eq(odhs_solver_set_param(a, "ordering_reuse", 0.5), ODHS_E_INVALID);
+    memset(x2, 0, nc2 * sizeof *x2);
+    ck_assert(cm_vs_dense(a, net2, b2, x2) < 1e-10);
+    const char *bname = NULL, *why = NULL;
+    ck_assert_int_eq(odhs_solver_backend_name(a, &bname, &why), ODHS_OK);
+    ck_assert_str_eq(bname, "cholmod-pcg");
+    ck_assert_double_eq(cm_stat(a, "ordering"), 1.0);
+    ck_assert_double_eq(cm_stat(a, "ordering_reuse"), 1.5);
+    odhs_solver_destroy(a);
+    odhs_solver_destroy(p);
+    odhs_solver_destroy(f);
+    odhs_network_destroy(thin);
+    odhs_network_destroy(net);
+    cm_case_free(&c2);
+    odhs_system_destroy(sys);
+    free(b);
+    free(x);
+    free(b2);
+    free(x2);
 }
 END_TEST
 
@@ -1382,6 +1630,11 @@ Suite *make_cholmod_suite(void)
     tcase_add_test(tc, test_pcg_bulk_insertions);
     tcase_add_test(tc, test_pcg_supernodal);
     tcase_add_test(tc, test_pcg_supernodal_switch);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("ordering");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_pcg_ordering);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("stepper");

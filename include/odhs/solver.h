@@ -107,16 +107,35 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod;
  *  where supernodes are 1.1-1.9x dearer; 150 also takes 3D networks of
  *  500-1000 particles, 1.5x cheaper at N = 600; docs/performance.md,
  *  0.2.21; 0.2.20's -1 used CHOLMOD's switch, 40), "openmp" (since
- *  0.2.21; as for "cholmod"). A new "supernodal" or "supernodal_switch"
- *  takes effect at the next full factorisation after an analysis: at the
- *  next setup (the next change of the network) or a refactorisation inside
- *  a solve. Statistics: "iterations",
+ *  0.2.21; as for "cholmod"), "ordering" (since 0.2.23; the fill-reducing
+ *  ordering of the contact matrix: -1, the default, CHOLMOD's choice (AMD,
+ *  and METIS too when AMD's factor has at least 500 flops per entry and 5
+ *  times the entries of the matrix; the better of the two), 0 AMD, 1 METIS),
+ *  "ordering_reuse" (since 0.2.23; -1, the default: on, with bound 1.1,
+ *  after a fresh ordering that called METIS, off otherwise; 0: off, every
+ *  analysis orders afresh, as up to 0.2.22; X >= 1: on, with bound X): an
+ *  analysis for a changed contact set carries the last ordering over
+ *  (contacts kept keep their rank, new contacts go last) instead of ordering
+ *  afresh, while the fill per contact stays within the bound times that of the last
+ *  fresh ordering; past it, the analysis orders afresh. METIS is the dear
+ *  part of an analysis: on 3D networks from a few thousand particles this
+ *  makes batched steps about 1.6x cheaper; where AMD alone orders, the
+ *  carried orderings' extra fill (4-5 % more entries in L) made them 5-10 %
+ *  dearer (docs/performance.md, 0.2.23). In a CHOLMOD built without METIS,
+ *  "ordering" = 1 falls back to AMD (CHOLMOD's own backup). A new
+ *  "supernodal", "supernodal_switch" or "ordering" takes effect at the next
+ *  full factorisation after an analysis: at the next setup (the next change
+ *  of the network) or a refactorisation inside a solve. Statistics:
+ *  "iterations",
  *  "updates", "packs" (since 0.2.19), "supernodal" (since 0.2.20: 1 when
  *  the last full factorisation went by supernodes), "factorizations",
  *  "analyses", "rcond", "nnz_L", "flops" and "lnz" (since 0.2.21: the
  *  flops and the entries of L that the last analysis predicts; their ratio
- *  decides "supernodal" = -1), "capacity", and the parameters "tol",
- *  "update_max", "supernodal_switch", "openmp". */
+ *  decides "supernodal" = -1), "orderings" (since 0.2.23: analyses that
+ *  ordered afresh; "analyses" counts all, a carried one rejected as stale
+ *  included), "capacity", and the parameters
+ *  "tol", "update_max", "supernodal_switch", "openmp", "ordering",
+ *  "ordering_reuse". */
 ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
 /** SuiteSparseQR on A = S^T (only in builds with SuiteSparse; otherwise
  *  "spqr" gives ODHS_E_NOTINSTALLED): solve_ls computes the least-squares
@@ -170,8 +189,9 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_dense;
  *  SuiteSparse build choose as a build without it (1 in a build without
  *  gives ODHS_E_NOTINSTALLED). "tol" (since 0.2) is handed to the iterative
  *  backends cg and cholmod-pcg (their relative residual; default theirs,
- *  1e-12); "update_max" (since 0.2.14), "supernodal" (since 0.2.20) and
- *  "supernodal_switch" (since 0.2.21) to cholmod-pcg; "openmp" (since
+ *  1e-12); "update_max" (since 0.2.14), "supernodal" (since 0.2.20),
+ *  "supernodal_switch" (since 0.2.21), "ordering" and "ordering_reuse"
+ *  (since 0.2.23) to cholmod-pcg; "openmp" (since
  *  0.2.21) to cholmod and cholmod-pcg. Statistics: "backend" and "primary" (codes
  *  0 cg, 1 dense, 2 cholmod, 3 cholmod-pcg, 4 spqr, 5 lsq-svd, 6 lsq-cg,
  *  7 lsq-pcg (since 0.2.16); -1

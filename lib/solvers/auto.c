@@ -88,6 +88,8 @@ typedef struct {
     double supernodal;    /* "supernodal" of cholmod-pcg (since 0.2.20; default -1 since 0.2.21) */
     double supernodal_switch; /* of cholmod-pcg (since 0.2.21); NAN: the backend's default */
     double openmp;        /* "openmp" of cholmod and cholmod-pcg (since 0.2.21) */
+    double ordering;      /* "ordering" of cholmod-pcg (since 0.2.23); NAN: the backend's default */
+    double ordering_reuse; /* "ordering_reuse" of cholmod-pcg (since 0.2.23); NAN: the backend's default */
     int prefer, retry_after, retry_after_lsq;
     /* state */
     int sticky_backend;   /* backend to try first, -1: none */
@@ -119,6 +121,8 @@ static int auto_create(void **state)
     s->update_max = 0.125;
     s->supernodal = -1.0;
     s->supernodal_switch = NAN;
+    s->ordering = NAN;
+    s->ordering_reuse = NAN;
     s->sticky_backend = -1;
     s->last = s->primary = -1;
     *state = s;
@@ -168,6 +172,12 @@ static int auto_set_param(void *state, const char *key, double v)
     } else if (!strcmp(key, "supernodal_switch") && v >= 0.0 && v <= 1e300) {
         s->supernodal_switch = v;
         if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "supernodal_switch", v);
+    } else if (!strcmp(key, "ordering") && (v == -1.0 || v == 0.0 || v == 1.0)) {
+        s->ordering = v;
+        if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "ordering", v);
+    } else if (!strcmp(key, "ordering_reuse") && (v == -1.0 || v == 0.0 || (v >= 1.0 && v <= 1e300))) {
+        s->ordering_reuse = v;
+        if (s->h[B_CHOLMOD_PCG]) odhs_solver_set_param(s->h[B_CHOLMOD_PCG], "ordering_reuse", v);
     } else if (!strcmp(key, "openmp") && (v == 0.0 || v == 1.0)) {
         s->openmp = v;
         if (s->h[B_CHOLMOD]) odhs_solver_set_param(s->h[B_CHOLMOD], "openmp", v);
@@ -219,6 +229,9 @@ static int handle(auto_state *s, int b, odhs_solver **out)
         if (b == B_CHOLMOD_PCG && s->supernodal != -1.0) odhs_solver_set_param(s->h[b], "supernodal", s->supernodal);
         if (b == B_CHOLMOD_PCG && !isnan(s->supernodal_switch))
             odhs_solver_set_param(s->h[b], "supernodal_switch", s->supernodal_switch);
+        if (b == B_CHOLMOD_PCG && !isnan(s->ordering)) odhs_solver_set_param(s->h[b], "ordering", s->ordering);
+        if (b == B_CHOLMOD_PCG && !isnan(s->ordering_reuse))
+            odhs_solver_set_param(s->h[b], "ordering_reuse", s->ordering_reuse);
         if ((b == B_CHOLMOD || b == B_CHOLMOD_PCG) && s->openmp != 0.0) odhs_solver_set_param(s->h[b], "openmp", s->openmp);
     }
     *out = s->h[b];
