@@ -101,6 +101,11 @@ ODHS_API extern const odhs_solver_type odhs_solver_type_cholmod_pcg;
 #define NO_SLOT SIZE_MAX
 
 typedef struct {
+    size_t i, j; /* a contact's pair */
+    int rank;    /* its place in the analysis's ordering */
+} pcg_ord;
+
+typedef struct {
     cholmod_common c;
     cholmod_sparse *A;        /* [S | E] of the last full factorisation */
     cholmod_factor *L;        /* simplicial LDL' of the slot matrix M */
@@ -142,9 +147,8 @@ typedef struct {
     int ordering;             /* "ordering": -1 CHOLMOD's choice, 0 AMD, 1 METIS */
     double reuse;             /* "ordering_reuse": -1 automatic, 0 off, else the fill growth that ends a reuse */
     int fresh_nd;             /* the last fresh ordering called METIS */
-    size_t *oi, *oj;          /* the last analysis's contacts (pairs) ... */
-    int *orank;               /* ... and their ranks in its ordering */
-    size_t ocap, on;          /* allocation; contacts held (0: no ordering to carry) */
+    pcg_ord *ord;             /* the last analysis's contacts and their ranks */
+    size_t ordcap, on;        /* allocation; contacts held (0: no ordering to carry) */
     double fresh_lnz;         /* lnz per contact of the last fresh ordering */
     double orderings;         /* fresh orderings (statistics) */
     int *cperm;               /* slot ordering handed to cholmod_analyze_p */
@@ -220,9 +224,7 @@ static void pcg_destroy(void *state)
     odhs__free(s->start);
     odhs__free(s->inc);
     odhs__free(s->w);
-    odhs__free(s->oi);
-    odhs__free(s->oj);
-    odhs__free(s->orank);
+    odhs__free(s->ord);
     odhs__free(s->cperm);
     odhs__free(s);
 }
@@ -335,8 +337,8 @@ static int pcg_carry(pcg_state *s, const odhs_network *net, size_t cap)
         kv[c].c = c;
     }
     for (size_t q = 0; q < s->on; ++q) {
-        size_t k = odhs__net_find(net, s->oi[q], s->oj[q]);
-        if (k != SIZE_MAX) kv[k].key = (double)s->orank[q];
+        size_t k = odhs__net_find(net, s->ord[q].i, s->ord[q].j);
+        if (k != SIZE_MAX) kv[k].key = (double)s->ord[q].rank;
     }
     qsort(kv, nc, sizeof *kv, pcg_key_cmp);
     for (size_t c = 0; c < nc; ++c) s->cperm[c] = (int)kv[c].c;
@@ -350,28 +352,34 @@ static int pcg_carry(pcg_state *s, const odhs_network *net, size_t cap)
  * analysis orders afresh */
 static void pcg_keep_order(pcg_state *s, const odhs_network *net)
 {
-    size_t nc = net->nc, cap = s->L->n;
+    size_t nc = net->nc;
     s->on = 0;
-    if (s->ocap < nc) {
-        size_t oc = nc + nc / 4 + 16;
-        void *a = odhs__realloc(s->oi, oc * sizeof *s->oi);
-        if (a) s->oi = a;
-        void *b = odhs__realloc(s->oj, oc * sizeof *s->oj);
-        if (b) s->oj = b;
-        void *c = odhs__realloc(s->orank, oc * sizeof *s->orank);
-        if (c) s->orank = c;
-        if (!a || !b || !c) return;
-        s->ocap = nc + nc / 4 + 16;
-    }
+    if (odhs__reserve((void **)&s->ord, &s->ordcap, nc, sizeof *s->ord)) return;
     const int *perm = s->L->Perm;
-    if (odhs__reserve((void **)&s->cperm, &s->cpermcap, cap, sizeof *s->cperm)) return;
-    for (size_t k = 0; k < cap; ++k) s->cperm[perm[k]] = (int)k; /* slot -> rank */
+    for (size_t k = 0; k < s->L->n; ++k)
+        if ((size_t)perm[k] < nc) s->ord[perm[k]].rank = (int)k; /* free slots have no pair */
     for (size_t c = 0; c < nc; ++c) {
-        s->oi[c] = net->ci[c];
-        s->oj[c] = net->cj[c];
-        s->orank[c] = s->cperm[c];
+        s->ord[c].i = net->ci[c];
+        s->ord[c].j = net->cj[c];
     }
     s->on = nc;
+}
+
+/* cholmod_analyze_p of s->A by one method (CHOLMOD_GIVEN with perm, AMD
+ * or METIS), or by CHOLMOD's own choice (method < 0); the common's
+ * settings as they were afterwards */
+static int pcg_cm_analyze(pcg_state *s, int *perm, int method)
+{
+    int nm = s->c.nmethods, om = s->c.method[0].ordering;
+    if (method >= 0) {
+        s->c.nmethods = 1;
+        s->c.method[0].ordering = method;
+    }
+    s->L = cholmod_analyze_p(s->A, perm, NULL, 0, &s->c);
+    s->c.nmethods = nm;
+    s->c.method[0].ordering = om;
+    s->status = s->c.status;
+    return s->L ? ODHS_OK : odhs__cm_error(&s->c);
 }
 
 /* Symbolic analysis of the slot matrix (s->A, cap slots): by "ordering",
@@ -380,21 +388,11 @@ static void pcg_keep_order(pcg_state *s, const odhs_network *net)
  * that of the last fresh ordering */
 static int pcg_analyze(pcg_state *s, const odhs_network *net, size_t cap)
 {
-    int st = ODHS_OK;
-    int nm = s->c.nmethods, om = s->c.method[0].ordering, po = s->c.postorder;
+    int st;
     double nc = net->nc ? (double)net->nc : 1.0;
     double bound = s->reuse > 0.0 ? s->reuse : s->reuse < 0.0 && s->fresh_nd ? PCG_ORDERING_REUSE : 0.0;
     if (bound > 0.0 && s->on > 0) {
-        if ((st = pcg_carry(s, net, cap))) return st;
-        s->c.nmethods = 1;
-        s->c.postorder = 1;
-        s->c.method[0].ordering = CHOLMOD_GIVEN;
-        s->L = cholmod_analyze_p(s->A, s->cperm, NULL, 0, &s->c);
-        s->c.nmethods = nm;
-        s->c.method[0].ordering = om;
-        s->c.postorder = po;
-        s->status = s->c.status;
-        if (!s->L) return odhs__cm_error(&s->c);
+        if ((st = pcg_carry(s, net, cap)) || (st = pcg_cm_analyze(s, s->cperm, CHOLMOD_GIVEN))) return st;
         if (s->c.lnz / nc <= bound * s->fresh_lnz) {
             pcg_keep_order(s, net);
             return ODHS_OK;
@@ -402,15 +400,8 @@ static int pcg_analyze(pcg_state *s, const odhs_network *net, size_t cap)
         cholmod_free_factor(&s->L, &s->c); /* grown stale: order afresh */
         s->analyses += 1.0;                 /* the rejected one counts too */
     }
-    if (s->ordering >= 0) {
-        s->c.nmethods = 1;
-        s->c.method[0].ordering = s->ordering == 0 ? CHOLMOD_AMD : CHOLMOD_METIS;
-    }
-    s->L = cholmod_analyze(s->A, &s->c);
-    s->c.nmethods = nm;
-    s->c.method[0].ordering = om;
-    s->status = s->c.status;
-    if (!s->L) return odhs__cm_error(&s->c);
+    if ((st = pcg_cm_analyze(s, NULL, s->ordering < 0 ? -1 : s->ordering == 0 ? CHOLMOD_AMD : CHOLMOD_METIS)))
+        return st;
     s->orderings += 1.0;
     s->fresh_lnz = s->c.lnz / nc;
     s->fresh_nd = s->c.called_nd;
