@@ -623,6 +623,57 @@ static odhs_system *grid_system(int dim, size_t n)
     return sys;
 }
 
+/* A rattler squeezed in a narrow channel (0.2.24): discs A and B of the
+ * backbone (a K5 less one contact, 0..4) hold rattler R between them, each
+ * overlapping it by 1e-13 of the contact distance, their normals tilted by
+ * 0.02 rad from the channel's axis, so that R clears both only after a move
+ * of about 1e-13 / sin(0.02) = 5e-12 along the channel. The push of
+ * odhs__st_jam_rattlers frees it and moves nothing else; up to 0.2.23 each
+ * sweep pushed R out of A and out of B from the same positions, gaining
+ * 2 sin^2(0.02) of the overlap per sweep, and left 0.84 of it after its 200
+ * sweeps (the case of two rattlers wedged in a 3D N = 8000 packing,
+ * docs/jamming.md). */
+START_TEST(test_rattler_out_of_channel)
+{
+    const double th = 0.02, ov = 1e-13, c = 10.0;
+    /* A (disc 0) and B (disc 1) below R's place (c, c), at 1 - ov along the
+     * tilted normals; discs 2-4 far away; R (disc 5) two diameters above */
+    double x[12] = {c - (1.0 - ov) * cos(th), c - (1.0 - ov) * sin(th), c + (1.0 - ov) * cos(th),
+                    c - (1.0 - ov) * sin(th), 3.0, 16.0, 6.0, 6.0, 16.0, 16.0, c, c + 2.0};
+    double r[6] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5}, L[2] = {20.0, 20.0};
+    odhs_system *sys;
+    odhs_driver *drv;
+    odhs_solver *sol;
+    odhs_stepper *st;
+    CHECK_OK(odhs_system_create(2, 6, &sys));
+    CHECK_OK(odhs_system_set_configuration(sys, L, 0.0, r, x));
+    CHECK_OK(odhs_driver_create(&drv));
+    CHECK_OK(odhs_solver_create_by_name("dense", &sol));
+    CHECK_OK(odhs_stepper_create(sys, drv, sol, &st));
+    CHECK_OK(odhs_stepper_reset(st));
+    odhs_network *net = st->net;
+    while (net->nc) odhs__net_remove_at(net, net->nc - 1);
+    for (size_t i = 0; i < 5; ++i)
+        for (size_t j = i + 1; j < 5; ++j)
+            if (!(i == 3 && j == 4)) ck_assert(odhs__net_add(net, i, j, ODHS_CONTACT_TEMPORARY) != SIZE_MAX);
+    sys->x[11] = c; /* R into the channel */
+    double x0[12];
+    memcpy(x0, sys->x, sizeof x0);
+    CHECK_OK(odhs__st_jam_rattlers(st));
+    for (int k = 0; k < 10; ++k) ck_assert_msg(sys->x[k] == x0[k], "backbone coordinate %d moved", k);
+    double dA = hypot(sys->x[10] - sys->x[0], sys->x[11] - sys->x[1]);
+    double dB = hypot(sys->x[10] - sys->x[2], sys->x[11] - sys->x[3]);
+    double up = sys->x[11] - c, side = sys->x[10] - c;
+    ck_assert_msg(dA >= 1.0 - 1e-15 && dB >= 1.0 - 1e-15 && up > 0.5 * ov / sin(th) && up < 1e-9 && fabs(side) < 1e-12,
+                  "R at %.3e, %.3e from the channel's start: overlaps %.3e (A), %.3e (B)", side, up, 1.0 - dA,
+                  1.0 - dB);
+    odhs_stepper_destroy(st);
+    odhs_solver_destroy(sol);
+    odhs_driver_destroy(drv);
+    odhs_system_destroy(sys);
+}
+END_TEST
+
 /* own iterated removal: particles with < d+1 contacts inside the subset */
 static void own_constrained(int dim, size_t n, size_t m, const size_t *pi, const size_t *pj, unsigned char *in,
                             size_t *nbar, size_t *ncon)
@@ -1203,30 +1254,34 @@ START_TEST(test_quench_report)
 END_TEST
 
 /* The rescalings of the quench toward phi_J (0.2.11): from the default
- * quench_phi the soft packing is rescaled 1-4 times, and the chain starts
- * close below the packing's phi_J (within 0.004: without the rescalings,
- * 0.02-0.03 below it). 2D N = 256 seed 8 lands on a degenerate vertex (a
- * backbone contact of zero force) and is certified only after shakes solved
- * by the dual simplex (with the primal start of the first programme after
- * each shake it stays degenerate: -1.5e-14 of the mean force) */
+ * quench_phi the soft packing is rescaled (7-8 times here), and the chain
+ * starts close below the packing's phi_J: within 1e-4 since 0.2.24 (about
+ * 1e-5 here; 0.2.11-0.2.23, which stopped at a mean overlap of 3e-4, 1e-3;
+ * without the rescalings 0.02-0.03 below it). 2D N = 512 seed 11 lands on
+ * a degenerate vertex (a backbone contact of zero force) and is certified
+ * only after a shake solved by the dual simplex (from the closer start of
+ * 0.2.24 no 2D N = 256 seed in 1-24 does, nor N = 64 or 128 in 1-30; up to
+ * 0.2.23 N = 256 seed 8 did, and with the primal start of the first
+ * programme after each shake it stayed degenerate: -1.5e-14 of the mean
+ * force) */
 START_TEST(test_quench_rescaled)
 {
     static const struct {
         int dim;
         size_t n;
         uint64_t seed;
-    } cases[4] = {{2, 256, 1}, {2, 256, 2}, {3, 343, 1}, {2, 256, 8}};
+    } cases[4] = {{2, 256, 1}, {2, 256, 2}, {3, 343, 1}, {2, 512, 11}};
     double phi0;
     odhs_jam_lp_report rep = {.size = sizeof rep};
     odhs_jam_certificate c = {.size = sizeof c};
     char msg[768] = "";
     int rc, ok = quench_run(cases[_i].dim, cases[_i].n, cases[_i].seed, 0.0, &phi0, &rep, &c, msg, sizeof msg, &rc);
     ck_assert_msg(ok, "case %d: status %d: %s", _i, rc, msg);
-    ck_assert_msg(rep.quench_steps >= 1 && rep.quench_steps <= 4 && rep.phi_start < c.phi &&
-                      rep.phi_start > c.phi - 0.004,
+    ck_assert_msg(rep.quench_steps >= 1 && rep.quench_steps <= 20 && rep.phi_start < c.phi &&
+                      rep.phi_start > c.phi - 1e-4,
                   "case %d: %zu rescalings, the chain from phi = %.6f, jammed at %.6f", _i, rep.quench_steps,
                   rep.phi_start, c.phi);
-    if (_i == 3) ck_assert_msg(rep.shakes >= 1, "seed 8: %zu shakes (the degenerate packing is the point)", rep.shakes);
+    if (_i == 3) ck_assert_msg(rep.shakes >= 1, "2D N = 512 seed 11: %zu shakes (the degenerate packing is the point)", rep.shakes);
 }
 END_TEST
 
@@ -1265,9 +1320,10 @@ START_TEST(test_lp_active_contacts)
 END_TEST
 
 /* The end game by batched-event steps (0.2.22, the default): a chain
- * stopped early (tol 1e-6) leaves 2D N = 256 seeds 3 and 4 unjammed at the
- * reset. The stepper's own Heun steps take about 200 and 60 steps to jam
- * them, one event and solve at a time; batched steps about 45 and 25 (the
+ * stopped early (tol 1e-6) leaves 2D N = 256 seeds 3 and 5 unjammed at the
+ * reset (seed 4 up to 0.2.23; from the closer quench start of 0.2.24 it is
+ * jammed there). The stepper's own Heun steps take about 360 and 130 steps
+ * to jam them, one event and solve at a time; batched steps about 55 and 50 (the
  * batched integrator's steps and its exact fallbacks together, as its
  * statistics count them). Both end games are the same compression in the
  * limit of small steps; from these starts they reach the same jammed
@@ -1289,7 +1345,7 @@ static void lp_settings_now(const jrun *r, int *integ, double *dt, double *tol, 
 
 START_TEST(test_lp_batched_end_game)
 {
-    static const uint64_t seeds[2] = {3, 4};
+    static const uint64_t seeds[2] = {3, 5};
     double phi[3], t_end[3];
     size_t nc[3];
     uint64_t steps[3];
@@ -1412,8 +1468,9 @@ START_TEST(test_lp_primal_start)
         odhs_jam_lp_report rep = {.size = sizeof rep};
         int rc = odhs_stepper_jam_lp(r.st, &o, &rep);
         jrun_free(&r);
-        ck_assert_msg(rc == ODHS_E_STALLED && rep.n_lps == 1, "case %d, dual %d: status %d after %zu programmes", _i,
-                      v, rc, rep.n_lps);
+        /* from the quench start of 0.2.24 one programme can jam the packing */
+        ck_assert_msg((rc == ODHS_E_STALLED || rc == ODHS_JAMMED) && rep.n_lps == 1,
+                      "case %d, dual %d: status %d after %zu programmes", _i, v, rc, rep.n_lps);
         piv[v] = rep.simplex_iterations;
         growth[v] = rep.growth_last;
     }
@@ -2774,6 +2831,7 @@ Suite *make_jamming_suite(void)
     tc = tcase_create("rattlers");
     tcase_add_test(tc, test_rattler_chain_2d);
     tcase_add_test(tc, test_rattler_chain_3d);
+    tcase_add_test(tc, test_rattler_out_of_channel);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("pressure");

@@ -27,7 +27,7 @@ extern "C" {
 /* ---- version ------------------------------------------------------------ */
 #define ODHS_VERSION_MAJOR 0
 #define ODHS_VERSION_MINOR 2
-#define ODHS_VERSION_PATCH 23
+#define ODHS_VERSION_PATCH 24
 /* MAJOR*10000 + MINOR*100 + PATCH */
 #define ODHS_VERSION_NUMBER \
     (ODHS_VERSION_MAJOR * 10000 + ODHS_VERSION_MINOR * 100 + ODHS_VERSION_PATCH)

@@ -313,6 +313,9 @@ int odhs__st_rewire_block(odhs_stepper *st);
 int odhs__st_batched_chord_pairs(odhs_stepper *st, const double *G, const double *vel, size_t *nv);
 int odhs__st_open_contact(odhs_stepper *st, size_t k, double *x);
 int odhs__st_jam_finish(odhs_stepper *st);
+/* endgame.c: rattlers pushed out of the pairs they overlap (part of
+ * odhs__st_jam_finish; exported for the tests) */
+int odhs__st_jam_rattlers(odhs_stepper *st);
 
 /* ---- neighbours.c, predict.c, motion.c ------------------------------------ */
 int odhs__st_build_neighbours(odhs_stepper *st);

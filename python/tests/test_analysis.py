@@ -158,19 +158,21 @@ def test_jam_lp_quench_certified():
     c = st.certificate()
     assert c.jammed and c.isostatic and c.force_balance < 1e-12 and c.gap_error < 1e-13 and c.overlap <= 1e-14
     assert c.min_force > 0 and rep.quench_iterations > 0 and 0.7 < rep.phi_start < 0.86 and rep.phi_start < c.phi
-    # since 0.2.11 the quench is rescaled toward phi_J before the chain starts
-    assert 1 <= rep.quench_steps <= 4 and rep.phi_start > c.phi - 0.01
+    # since 0.2.11 the quench is rescaled toward phi_J before the chain starts; since 0.2.24
+    # to a mean overlap of 3e-6 (at most 20 rescalings), and the chain starts within 1e-4
+    assert 1 <= rep.quench_steps <= 20 and rep.phi_start > c.phi - 1e-4
 
 
 def test_jam_lp_batched_end_game():
     # since 0.2.22 the end game steps with the batched integrator where the chain leaves the
-    # packing unjammed (a chain stopped at tol 1e-6: 2D N = 256, seed 4), and puts the
+    # packing unjammed (a chain stopped at tol 1e-6: 2D N = 256, seed 5; seed 4 up to 0.2.23,
+    # which the closer quench start of 0.2.24 leaves jammed at the reset), and puts the
     # stepper's settings back; own_integrator=True steps with the stepper's own integrator
     out = []
     for own in (False, True):
         s = odhs.System(2, 256)
-        s.set_radii_bidisperse(0.5, 1.4, 0.03, 4)
-        s.place_random(0.45, 5)
+        s.set_radii_bidisperse(0.5, 1.4, 0.03, 5)
+        s.place_random(0.45, 6)
         st = odhs.Stepper(s, odhs.Driver(compression_rate=1.0), odhs.Solver("dense"), correction_interval=1)
         st.tolerance = 2e-6
         before = st.settings
