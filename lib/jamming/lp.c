@@ -60,7 +60,7 @@
 #define LP_QUENCH_STEPS 20     /* rescalings of the quench toward phi_J at most ... */
 #define LP_QUENCH_OVERLAP 3e-6 /* ... until the contacts' mean overlap (relative) is below this */
 #define LP_QUENCH_FREL 1e-3    /* a relaxation after a rescaling stops at this fraction of the
-                                * mean contact force (at most LP_QUENCH_FORCE: the larger) */
+                                * mean contact force, or at LP_QUENCH_FORCE if that is larger */
 
 /* the fields of the options and the report the caller's size must cover */
 #define LP_OPT_MIN (offsetof(odhs_jam_lp_options, max_steps) + sizeof(size_t))
@@ -443,7 +443,7 @@ static int lp_quench(odhs_stepper *st, const odhs_jam_lp_options *o, lp_work *w,
      * saves. The chain then starts within about 1e-5 of its phi_J, and
      * its first programme is cheaper the larger the packing: 3D N = 3000
      * 9 690 pivots and 7.5 CPU s against 18 011 and 32 s; 3D N = 8000
-     * 29 956 and 148 s against 77 088 and 1 142 s (docs/jamming.md). */
+     * 27 962 and 101 s against 77 088 and 1 142 s (docs/jamming.md). */
     lp_dilate_ctx c = {tmp->r, 1.0, 0.0, 0};
     for (int k = 0;; ++k) {
         uint64_t it = 0;
