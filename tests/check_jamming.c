@@ -1523,6 +1523,50 @@ START_TEST(test_lp_shake)
 }
 END_TEST
 
+/* A reset on the chain's packing that its own final check refuses (0.2.24):
+ * the network is potentially jammed, but after the polish the self-stress
+ * has a negative component (a degenerate vertex: 2D N = 16384, seed 1,
+ * -2.6e-4 of the mean force). The chain's packing is then shaken and the
+ * chain runs again, as for a degenerate packing after the end game; up to
+ * 0.2.23 the call returned ODHS_POTENTIALLY_JAMMED. The test hook refuses
+ * the first reset (then the call must still certify, after one shake), or
+ * every reset (then it returns ODHS_POTENTIALLY_JAMMED after 3 shakes, with
+ * the system as it was before the call and the reset's message). */
+START_TEST(test_lp_reset_refused)
+{
+    jrun r;
+    jrun_start(&r, 2, 64, 3, "compress", "default");
+    jrun_configure(&r);
+    odhs__stepper_set_lp_reset_fail(r.st, 1);
+    odhs_jam_lp_report rep = {.size = sizeof rep};
+    r.rc = odhs_stepper_jam_lp(r.st, NULL, &rep);
+    char msg[768] = "";
+    int ok = r.rc == ODHS_JAMMED && independent_check(&r, msg, sizeof msg);
+    int rc = r.rc;
+    jrun_free(&r);
+    ck_assert_msg(ok && rep.shakes == 1 && rep.growth_last < 1e-12, "one reset refused: status %d, %zu shakes: %s", rc,
+                  rep.shakes, msg);
+    jrun_start(&r, 2, 64, 3, "compress", "default");
+    jrun_configure(&r);
+    size_t n = 64;
+    double *x0 = xcalloc(2 * n, sizeof *x0), *x1 = xcalloc(2 * n, sizeof *x1), L0[3], L1[3];
+    CHECK_OK(odhs_system_get_positions(r.sys, x0));
+    CHECK_OK(odhs_system_get_box(r.sys, L0));
+    odhs__stepper_set_lp_reset_fail(r.st, 100);
+    memset(&rep, 0, sizeof rep);
+    rep.size = sizeof rep;
+    rc = odhs_stepper_jam_lp(r.st, NULL, &rep);
+    CHECK_OK(odhs_system_get_positions(r.sys, x1));
+    CHECK_OK(odhs_system_get_box(r.sys, L1));
+    ck_assert_msg(rc == ODHS_POTENTIALLY_JAMMED && !memcmp(x0, x1, 2 * n * sizeof *x0) && L0[0] == L1[0] &&
+                      L0[1] == L1[1] && strstr(odhs_stepper_errmsg(r.st), "test hook"),
+                  "every reset refused: status %d (%s)", rc, odhs_stepper_errmsg(r.st));
+    free(x0);
+    free(x1);
+    jrun_free(&r);
+}
+END_TEST
+
 /* jam_packing --protocol shear --method lp (and quench+lp): the fast route
  * jams, the packing is dilated by 0.2% and sheared at fixed volume until it
  * arrests; the shear jammed packing is certified as any other */
@@ -2890,6 +2934,7 @@ Suite *make_jamming_suite(void)
     tcase_add_loop_test(tc, test_quench_polish, 0, 3);
     tcase_add_test(tc, test_quench_refined_f0);
     tcase_add_test(tc, test_lp_shake);
+    tcase_add_test(tc, test_lp_reset_refused);
     tcase_add_test(tc, test_lp_report_and_stall);
     tcase_add_loop_test(tc, test_lp_batched_end_game, 0, 2);
 #endif

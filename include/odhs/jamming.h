@@ -193,6 +193,11 @@ typedef struct odhs_jam_lp_report {
  * and can still open) is not returned: the configuration is dilated by
  * 1e-5, each coordinate moved by a deterministic noise of 1e-7 mean
  * diameters, and the chain runs again (at most 3 times; report.shakes).
+ * Since 0.2.24 the same is done when the reset on the chain's packing finds
+ * a potentially jammed network whose self-stress turns negative after the
+ * polish (ODHS_POTENTIALLY_JAMMED from the reset; a nearly force-free
+ * contact of such a vertex): the chain's packing is shaken and the chain
+ * runs again, where up to 0.2.23 the call returned that status.
  *
  * A different protocol from the event-driven compression: the programmes
  * move particles by up to `trust` at a time, not along the overdamped

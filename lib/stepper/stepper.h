@@ -19,6 +19,9 @@ void odhs__stepper_set_lp_min_force(odhs_stepper *st, double v);
 /* tests: 1 = jam_lp solves a programme without a basis by the dual simplex
  * from the slack basis (up to 0.2.10) instead of the primal values pass */
 void odhs__stepper_set_lp_cold_dual(odhs_stepper *st, int v);
+/* tests: the next v resets of odhs_stepper_jam_lp on a chain's packing are
+ * refused as ODHS_POTENTIALLY_JAMMED (a degenerate packing; lp.c) */
+void odhs__stepper_set_lp_reset_fail(odhs_stepper *st, int v);
 
 /* ---- stepper ------------------------------------------------------------------ */
 typedef struct {
@@ -106,6 +109,7 @@ struct odhs_stepper {
     uint64_t nrewire_monotone;  /* rewirings the anti-cycling method finished (not checkpointed) */
     uint64_t njam_pivots;       /* pivots of jam_finish on the final packing (not checkpointed) */
     double lp_min_force;        /* tests: jam_lp's degeneracy threshold (0: default; lp.c) */
+    int lp_reset_fail;          /* tests: resets of jam_lp refused (lp.c) */
     int lp_cold_dual;           /* tests: jam_lp solves a programme without a basis by the dual
                                  * simplex from the slack basis, as up to 0.2.10 (lp.c) */
     /* fixed pressure through the network without contact iso_k (pressure.c):
