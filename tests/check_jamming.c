@@ -1506,18 +1506,29 @@ END_TEST
  * jammed again: with the threshold raised past every force, each packing
  * counts as degenerate, so the call shakes 3 times and returns the last
  * packing, certified */
-START_TEST(test_lp_shake)
+/* jam_lp with its defaults on 2D N = 64 seed 3, with the test hooks set
+ * (min_force > 0: the degeneracy threshold; reset_fail: resets refused);
+ * *ok: jammed and passing the independent check (msg says why not) */
+static int lp_hooked_run(double min_force, int reset_fail, odhs_jam_lp_report *rep, char *msg, size_t len, int *ok)
 {
     jrun r;
     jrun_start(&r, 2, 64, 3, "compress", "default");
     jrun_configure(&r);
-    odhs__stepper_set_lp_min_force(r.st, 1e300);
-    odhs_jam_lp_report rep = {.size = sizeof rep};
-    r.rc = odhs_stepper_jam_lp(r.st, NULL, &rep);
-    char msg[768] = "";
-    int ok = r.rc == ODHS_JAMMED && independent_check(&r, msg, sizeof msg);
+    if (min_force > 0.0) odhs__stepper_set_lp_min_force(r.st, min_force);
+    odhs__stepper_set_lp_reset_fail(r.st, reset_fail);
+    *rep = (odhs_jam_lp_report){.size = sizeof *rep};
+    r.rc = odhs_stepper_jam_lp(r.st, NULL, rep);
+    *ok = r.rc == ODHS_JAMMED && independent_check(&r, msg, len);
     int rc = r.rc;
     jrun_free(&r);
+    return rc;
+}
+
+START_TEST(test_lp_shake)
+{
+    odhs_jam_lp_report rep;
+    char msg[768] = "";
+    int ok, rc = lp_hooked_run(1e300, 0, &rep, msg, sizeof msg, &ok);
     ck_assert_msg(ok && rep.shakes == 3 && rep.growth_last < 1e-12 && rep.polishes <= 2 * 4, "status %d, %zu shakes: %s",
                   rc, rep.shakes, msg);
 }
@@ -1534,18 +1545,12 @@ END_TEST
  * the system as it was before the call and the reset's message). */
 START_TEST(test_lp_reset_refused)
 {
-    jrun r;
-    jrun_start(&r, 2, 64, 3, "compress", "default");
-    jrun_configure(&r);
-    odhs__stepper_set_lp_reset_fail(r.st, 1);
-    odhs_jam_lp_report rep = {.size = sizeof rep};
-    r.rc = odhs_stepper_jam_lp(r.st, NULL, &rep);
+    odhs_jam_lp_report rep;
     char msg[768] = "";
-    int ok = r.rc == ODHS_JAMMED && independent_check(&r, msg, sizeof msg);
-    int rc = r.rc;
-    jrun_free(&r);
+    int ok, rc = lp_hooked_run(0.0, 1, &rep, msg, sizeof msg, &ok);
     ck_assert_msg(ok && rep.shakes == 1 && rep.growth_last < 1e-12, "one reset refused: status %d, %zu shakes: %s", rc,
                   rep.shakes, msg);
+    jrun r;
     jrun_start(&r, 2, 64, 3, "compress", "default");
     jrun_configure(&r);
     size_t n = 64;

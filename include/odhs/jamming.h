@@ -178,10 +178,10 @@ typedef struct odhs_jam_lp_report {
  * report.quench_steps), since 0.2.24 to a largest force of 1e-3 of the
  * mean contact force (or 1e-9, the larger). The result is dilated until
  * no pair overlaps; the chain starts there, since 0.2.24 within about
- * 1e-5 of its phi_J (3D N = 8000: a first programme 7.7 times as cheap). Above phi_J the
- * minimised soft packing is jammed, and its structure is close to a hard
- * jammed packing: the chain then needs tens of programmes where a start far
- * below jamming needs hundreds, each also cheaper (measured in
+ * 1e-5 of its phi_J (3D N = 8000: a first programme 11 times as cheap).
+ * Above phi_J the minimised soft packing is jammed, and its structure is
+ * close to a hard jammed packing: the chain then needs tens of programmes
+ * where a start far below jamming needs hundreds, each also cheaper (measured in
  * docs/jamming.md: 3D N = 1000 in about 10 CPU s against 3 CPU min). It is the
  * protocol of an infinitely fast quench, not a compression: its packings
  * are denser (2D N = 256, the same 12 starts: phi_J = 0.8434 +- 0.0016

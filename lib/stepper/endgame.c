@@ -177,7 +177,7 @@ typedef struct {
     size_t m, cap;
     struct jam_push {
         size_t i, j;
-        double v[3], dist, need;
+        double v[3], sig; /* the vector from i to j at the search; the contact distance */
     } *list;
     size_t over;
     int nomem;
@@ -198,13 +198,8 @@ static int jam_push_cb(size_t i, size_t j, const double *rij, double gap, void *
     struct jam_push *p = &c->list[c->m++];
     p->i = i;
     p->j = j;
-    p->dist = 0.0;
-    for (int a = 0; a < c->dim; ++a) {
-        p->v[a] = rij[a];
-        p->dist += rij[a] * rij[a];
-    }
-    p->dist = sqrt(p->dist);
-    p->need = sig; /* the contact distance */
+    for (int a = 0; a < c->dim; ++a) p->v[a] = rij[a];
+    p->sig = sig;
     if (gap < -1e-15 * sig) c->over++;
     return 0;
 }
@@ -264,8 +259,8 @@ int odhs__st_jam_rattlers(odhs_stepper *st)
                     dist += v[a] * v[a];
                 }
                 dist = sqrt(dist);
-                double need = (1.0 + JAM_RATTLER_MARGIN) * p->need - dist;
-                if (!(need > 0.5 * JAM_RATTLER_MARGIN * p->need) || !(dist > 0.0)) continue;
+                double need = (1.0 + JAM_RATTLER_MARGIN) * p->sig - dist;
+                if (!(need > 0.5 * JAM_RATTLER_MARGIN * p->sig) || !(dist > 0.0)) continue;
                 pushed = 1;
                 size_t ends[2] = {p->i, p->j};
                 double share = in[p->i] || in[p->j] ? 1.0 : 0.5;
